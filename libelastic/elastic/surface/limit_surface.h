@@ -1,0 +1,129 @@
+#pragma once
+/// \file
+/// `LimitSurface`: the smooth surface d(u,v) of the paper, here the subdivision limit surface of an
+/// arbitrary manifold control mesh, evaluated exactly (not by refinement) with OpenSubdiv's patch tables
+/// in double precision.
+///
+/// - Scheme: Loop for an all-triangle mesh, Catmull-Clark for quad and mixed meshes (overridable).
+/// - Boundaries are interpolated (OpenSubdiv VTX_BOUNDARY_EDGE_AND_CORNER): the limit surface ends on
+///   the control mesh's boundary curve, and valence-2 boundary corners are sharp.
+/// - Extraordinary vertices are handled by adaptive isolation with Gregory end caps.
+/// - Creases and corners from the mesh's `creases`/`corners` are applied (when `use_creases`).
+///
+/// Points are given as `SurfacePoint` (ptex face, u, v): see surface_point.h for the convention.
+///
+/// Ownership and threads: a LimitSurface copies what it needs from the control mesh and owns its
+/// OpenSubdiv tables. It can be moved, not copied. All const member functions are thread-safe.
+
+#include <Eigen/Core>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "elastic/mesh/polygon_mesh.h"
+#include "elastic/surface/surface_point.h"
+
+namespace elastic {
+
+enum class SubdivisionScheme {
+  Automatic,    ///< Loop when every face is a triangle, Catmull-Clark otherwise
+  Loop,         ///< Loop (triangle meshes only)
+  CatmullClark  ///< Catmull-Clark (any polygon mesh)
+};
+
+struct LimitSurfaceOptions {
+  /// Subdivision scheme; Automatic picks Loop for all-triangle meshes and Catmull-Clark otherwise.
+  SubdivisionScheme scheme = SubdivisionScheme::Automatic;
+  /// Depth of adaptive refinement around extraordinary vertices and creases (OpenSubdiv isolation level).
+  /// Higher is more accurate near extraordinary vertices and costs memory; 1..10.
+  int isolation_level = 6;
+  /// Apply the mesh's crease and corner sharpness tags.
+  bool use_creases = true;
+  /// Name of the surface for error messages (usually the file it came from).
+  std::string name = "surface";
+};
+
+/// Position and first and second derivatives with respect to the ptex parameters (u, v).
+struct SurfaceDerivatives {
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();
+  Eigen::Vector3d du = Eigen::Vector3d::Zero();
+  Eigen::Vector3d dv = Eigen::Vector3d::Zero();
+  Eigen::Vector3d duu = Eigen::Vector3d::Zero();
+  Eigen::Vector3d duv = Eigen::Vector3d::Zero();
+  Eigen::Vector3d dvv = Eigen::Vector3d::Zero();
+};
+
+/// Differential geometry at a point.
+/// Sign convention: normal curvature k(t) = -<d2P(t,t), normal> / |dP(t)|^2, so a convex surface bends away
+/// from its normal with positive curvature: a sphere with outward normals has k1 = k2 = +1/r, a cylinder of
+/// radius r with outward normals has k1 = 1/r, k2 = 0. Principal directions are unit 3D tangent vectors,
+/// k1 >= k2, and (dir1, dir2, normal) is right-handed.
+struct SurfaceCurvature {
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();  ///< unit normal, du x dv normalised
+  double k1 = 0.0;                                    ///< larger principal curvature
+  double k2 = 0.0;                                    ///< smaller principal curvature
+  Eigen::Vector3d dir1 = Eigen::Vector3d::UnitX();    ///< principal direction of k1 (unit, tangent)
+  Eigen::Vector3d dir2 = Eigen::Vector3d::UnitY();    ///< principal direction of k2 (unit, tangent)
+  double mean = 0.0;                                  ///< (k1 + k2) / 2
+  double gaussian = 0.0;                              ///< k1 * k2
+};
+
+class LimitSurface {
+ public:
+  /// Builds the limit surface of `mesh`.
+  /// \throws InvalidInputError naming `options.name` when the mesh is not a valid manifold polygon mesh
+  ///         (run validate_mesh first for a full report), or Loop is forced on a non-triangle mesh.
+  explicit LimitSurface(const PolygonMesh& mesh, const LimitSurfaceOptions& options = {});
+  ~LimitSurface();
+  LimitSurface(LimitSurface&&) noexcept;
+  LimitSurface& operator=(LimitSurface&&) noexcept;
+  LimitSurface(const LimitSurface&) = delete;
+  LimitSurface& operator=(const LimitSurface&) = delete;
+
+  /// The scheme actually used (never Automatic).
+  SubdivisionScheme scheme() const;
+  /// True for Loop, where ptex faces are triangles in (u, v).
+  bool triangular_domain() const { return scheme() == SubdivisionScheme::Loop; }
+  const std::string& name() const;
+
+  /// Number of ptex faces; valid SurfacePoint::face values are 0 .. num_faces()-1.
+  int num_faces() const;
+  /// The control-mesh face a ptex face belongs to.
+  int control_face(int ptex_face) const;
+  /// The first ptex face of a control face (an n-gon under Catmull-Clark has n consecutive ones).
+  int first_ptex_face(int control_face) const;
+  /// The control mesh as it was given (positions, faces, attributes).
+  const PolygonMesh& control_mesh() const;
+
+  /// True when (u, v) lies in the face's parameter domain (square or triangle), within `tolerance`.
+  bool in_domain(const SurfacePoint& p, double tolerance = 0.0) const;
+
+  /// Limit position d(u, v).
+  Eigen::Vector3d position(const SurfacePoint& p) const;
+  /// Limit position and first and second derivatives.
+  SurfaceDerivatives derivatives(const SurfacePoint& p) const;
+  /// Unit normal, principal curvatures and directions, mean and Gaussian curvature.
+  SurfaceCurvature curvature(const SurfacePoint& p) const;
+  /// Curvature from already evaluated derivatives (saves an evaluation).
+  static SurfaceCurvature curvature(const SurfaceDerivatives& d);
+
+  /// Moves from `from` by `delta` in parameter space, continuing into neighbouring ptex faces when the
+  /// straight path leaves the face (the remaining step is re-expressed in the neighbour's parameters).
+  /// Stops on the surface boundary (the result lies on the boundary edge). Never returns a point outside
+  /// a face's domain. `crossed` (optional) receives the number of ptex edges crossed.
+  SurfacePoint walk(const SurfacePoint& from, const Eigen::Vector2d& delta,
+                    int* crossed = nullptr) const;
+
+  /// True when p lies on the surface boundary (a ptex edge with no neighbour), within `tolerance` in (u,v).
+  bool on_boundary(const SurfacePoint& p, double tolerance = 1e-12) const;
+
+  /// Representative SurfacePoint at a control vertex's limit position, and at the centre of a ptex face.
+  SurfacePoint vertex_point(int control_vertex) const;
+  SurfacePoint face_center(int ptex_face) const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace elastic

@@ -1,0 +1,35 @@
+#pragma once
+// Shared helpers for the test suite: where test meshes live, and a scratch directory.
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <string>
+
+namespace elastic::test {
+
+/// The project's own procedural meshes (meshes/).
+inline std::filesystem::path project_mesh(const std::string& name) {
+  return std::filesystem::path(ELASTIC_MESHES_DIR) / name;
+}
+
+/// A public test mesh from ../shared/meshes, or an empty path when that folder is not there.
+inline std::filesystem::path shared_mesh(const std::string& name) {
+  const std::filesystem::path path = std::filesystem::path(ELASTIC_SHARED_MESHES_DIR) / name;
+  return std::filesystem::exists(path) ? path : std::filesystem::path();
+}
+
+/// A fresh, empty scratch directory for one test.
+inline std::filesystem::path scratch_dir(const std::string& name) {
+  const std::filesystem::path dir = std::filesystem::path(ELASTIC_TEST_OUTPUT_DIR) / name;
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  return dir;
+}
+
+}  // namespace elastic::test
+
+/// Skips the current test when a shared mesh is missing (../shared is optional for a clone).
+#define ELASTIC_REQUIRE_SHARED_MESH(var, name)                                  \
+  const std::filesystem::path var = ::elastic::test::shared_mesh(name);         \
+  if (var.empty()) GTEST_SKIP() << "../shared/meshes/" << (name) << " not present"
