@@ -1,0 +1,60 @@
+#pragma once
+/// \file
+/// Region specifications, as a user gives them on the command line or in the API, and building a Region
+/// from one on a surface:
+///
+///   disk:X,Y,Z,R     the geodesic disk of radius R around the surface point nearest to (X,Y,Z)
+///   points:FILE      a closed curve through 3+ points (one "x y z" per line), each projected onto the
+///                    surface, joined in order by shortest paths on the surface
+///   boundary         the surface's own boundary loop (an open surface with exactly one)
+///   uv:FILE          a closed polygon (one "u v" per line) in the texture domain of a mesh with UVs
+///
+/// The region is the side of the curve that is a disk; when both sides are disks (a closed genus-0
+/// surface) the smaller one by area. Its boundary is oriented counter-clockwise seen from the normal side.
+/// The anchor (start of the boundary correspondence) is the curve point nearest to `anchor` when given;
+/// otherwise it is chosen automatically (see make_region).
+
+#include <Eigen/Core>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "elastic/regions/region.h"
+
+namespace elastic {
+
+class SurfaceProjector;
+
+struct RegionSpec {
+  enum class Kind { Disk, Points, Boundary, UvPolygon };
+  Kind kind = Kind::Boundary;
+  Eigen::Vector3d center = Eigen::Vector3d::Zero();  ///< Disk: point near the surface
+  double radius = 0.0;                               ///< Disk: geodesic radius
+  std::vector<Eigen::Vector3d> points;               ///< Points: the curve's points, in order
+  std::vector<Eigen::Vector2d> uv_polygon;           ///< UvPolygon: the polygon in texture space
+  std::optional<Eigen::Vector3d> anchor;             ///< start of the correspondence, if the user gave one
+  std::string text;                                  ///< the spec as written, for messages
+};
+
+/// Parses a spec string. `flag` names where it came from (for messages), e.g. "--source-region".
+/// Reads FILE for points: and uv:. \throws InvalidInputError / IoError naming the flag or the file.
+RegionSpec parse_region_spec(std::string_view text, std::string_view flag = "region");
+
+struct RegionOptions {
+  /// A spec point farther from the surface than this fraction of the surface's bounding-box diagonal is
+  /// an error ("point is far from the surface").
+  double max_point_distance = 0.05;
+  /// Name used in error messages, e.g. "--target-region".
+  std::string name = "region";
+};
+
+/// Builds the region of `spec` on the projector's surface.
+/// \throws InvalidInputError naming options.name for: a curve that crosses itself, a region that is not
+///         a disk (holds a handle or a hole), a disk that covers a whole closed surface, a point far from
+///         the surface, `boundary` on a surface without exactly one boundary loop, `uv:` on a mesh
+///         without UVs, a degenerate curve (fewer than 3 distinct points, zero length).
+Region make_region(const SurfaceProjector& projector, const RegionSpec& spec,
+                   const RegionOptions& options = {});
+
+}  // namespace elastic
