@@ -1,0 +1,39 @@
+#pragma once
+/// \file
+/// Triangulating the band between two nested simple polygons in the plane (an annulus), without
+/// adding points: the constrained Delaunay triangulation of both polygons' vertices with every
+/// polygon edge a constraint, restricted to the faces between the two polygons. Used by the grid
+/// layout to join the quad grid's outline to the boundary particles (§4.1: boundary particles "are
+/// connected to the outside of the grid"). Delaunay maximises the smallest angle among
+/// triangulations of the same points and constraints, and no triangle can be degenerate (zero area)
+/// or inverted.
+///
+/// The implementation (CGAL's 2D constrained Delaunay triangulation with exact predicates) is
+/// confined to annulus_triangulation.cpp.
+
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+namespace elastic {
+
+struct AnnulusTriangulationOptions {
+  /// Name used in error messages.
+  std::string name = "annulus";
+};
+
+struct AnnulusTriangulation {
+  /// Triangles as indices into the caller's point array, counter-clockwise (positive signed area).
+  std::vector<Eigen::Vector3i> triangles;
+};
+
+/// Triangulates the region between `outer` and `inner`, both counter-clockwise loops of indices
+/// into `points` (not repeated at the end), `inner` strictly inside `outer`. \throws
+/// InvalidInputError naming options.name when a loop has fewer than 3 vertices, two used points
+///         coincide, or the polygons' edges cross each other (the band would need new points).
+AnnulusTriangulation triangulate_annulus(const std::vector<Eigen::Vector2d>& points,
+                                         const std::vector<int>& outer,
+                                         const std::vector<int>& inner,
+                                         const AnnulusTriangulationOptions& options = {});
+
+}  // namespace elastic

@@ -1,0 +1,88 @@
+#pragma once
+/// \file
+/// Laying out the particle grid of §4.1 on a source region, before adaptive sampling.
+///
+/// 1. The region is flattened (flatten_region, conformal by default so grid cells stay square-ish
+/// on the
+///    surface), oriented so its boundary runs counter-clockwise, scaled so its planar area equals
+///    the region's 3D area, and centred at its area centroid. Lengths in this plane approximate
+///    surface lengths (exactly for a developable region flattened isometrically).
+/// 2. For a spacing h, M = round(L / h) *boundary particles* are placed at equal arc length on the
+/// 3D
+///    boundary curve (length L), s_k = k / M from the anchor (SurfaceCurve::locate): exact to
+///    round-off.
+/// 3. Points of the axis-aligned square lattice of step h (origin at the centroid) are kept when
+/// they lie
+///    inside the boundary particles' polygon and at least `clearance * h` away from it. A lattice
+///    cell is a quad of the grid when its four corners are kept; the quads are cleaned to one
+///    edge-connected, hole-free set with a simple outline (cells touching only at a corner are
+///    removed). With clearance > 1/sqrt(2) no polygon point can lie inside a kept cell (the
+///    farthest point of a square from its nearest corner is its centre, h/sqrt(2) away), so the
+///    outline lies strictly inside the polygon.
+/// 4. The band between the outline and the boundary polygon is triangulated by constrained Delaunay
+///    (annulus_triangulation.h): no new points, no degenerate or inverted triangles.
+/// 5. h is found by a secant/bisection search on the *actual* count (lattice vertices of the quads
+/// plus
+///    M) so that it is within `count_tolerance` of the request.
+/// 6. Every particle is mapped to the surface through the flattening: 2D point location in the
+/// flattened
+///    region triangles, barycentric coordinates, Region::point_in_triangle. Interior particles sit
+///    at the limit position of that SurfacePoint; boundary particles on the boundary chord (see
+///    boundary_sampler.h).
+///
+/// The grid's faces are counter-clockwise seen from the normal side (the region's orientation).
+/// Rest values of the springs are set by ParticleGrid::build_springs() on the laid-out positions.
+
+#include <string>
+#include <vector>
+
+#include "elastic/particles/particle_grid.h"
+#include "elastic/regions/region.h"
+#include "elastic/regions/region_flattening.h"
+
+namespace elastic {
+
+struct GridLayoutOptions {
+  /// Requested number of particles N (interior + boundary). 16 .. 5,000,000.
+  long particles = 1000;
+  /// Stop the spacing search once |count - N| <= count_tolerance * N (the contract is 5%).
+  double count_tolerance = 0.01;
+  /// Largest accepted relative count error; the layout throws NumericalError beyond it.
+  double max_count_error = 0.05;
+  /// Minimum distance of a kept lattice point from the boundary polygon, in units of h. Must exceed
+  /// 1/sqrt(2) (see the file comment); larger values make the boundary band wider.
+  double clearance = 0.75;
+  /// Flattening used for the layout; Conformal falls back to Disk when it folds.
+  FlatteningMethod flattening = FlatteningMethod::Conformal;
+  /// Spacing search steps (each counts the lattice once).
+  int max_search_steps = 40;
+  /// Name of the region in error messages (e.g. "--region").
+  std::string name = "region";
+};
+
+struct GridLayoutResult {
+  ParticleGrid grid;
+  double spacing = 0.0;        ///< lattice step h (surface length units, see the file comment)
+  int interior_particles = 0;  ///< particles of the quad grid
+  int boundary_particles = 0;  ///< M, on the boundary curve
+  int quads = 0;               ///< grid faces that are lattice cells
+  int band_triangles = 0;      ///< triangles joining the grid outline to the boundary particles
+  double count_error = 0.0;    ///< (particles - N) / N
+  int search_steps = 0;        ///< lattice counts done by the spacing search
+  FlatteningMethod flattening = FlatteningMethod::Conformal;  ///< the flattening actually used
+  /// #P position of each particle in the scaled flattened plane.
+  std::vector<Eigen::Vector2d> flat_positions;
+  /// #P 1 for interior particles whose four lattice cells are all quads of the grid ("regular":
+  /// exactly four normal springs and four angular springs), 0 otherwise.
+  std::vector<char> is_regular;
+};
+
+/// Lays out about options.particles particles on `region` (see the file comment).
+/// \throws InvalidInputError naming options.name for an absurd count (outside 16 .. 5,000,000), an
+/// empty
+///         region, or a region too small or too thin for the count (fewer than 4 interior
+///         particles); NumericalError when the flattening folds or the count cannot be met within
+///         max_count_error.
+GridLayoutResult layout_particle_grid(const Region& region, const GridLayoutOptions& options = {});
+
+}  // namespace elastic
