@@ -1,0 +1,99 @@
+#pragma once
+/// \file
+/// Curvature-adaptive sampling of §4.3 (eqs. 6-8): particles of a laid-out grid migrate, with the
+/// grid's connectivity unchanged, towards where the surface bends.
+///
+/// Each interior particle i is pulled towards its grid neighbours j (the edges of the grid)
+/// weighted by
+///
+///     w_j = r(x_j) + floor * mean_k r(x_k),    r = sqrt((k1^2 + k2^2) / 2)     (the paper's r,
+///     §4.3)
+///
+/// The floor term is ours: with the paper's bare r a flat part (r = 0) exerts no pull and its
+/// particles would all drain into the curved parts; the floor keeps flat parts sampled (density ~ r
+/// + floor * mean r along a line, its square over an area). One Jacobi step moves every particle by
+///
+///     dx_i = relaxation * T_i( sum_j w_j (x_j - x_i) / sum_j w_j ),                  (eq. 8)
+///
+/// T_i the projection onto the tangent plane at x_i; the magnet (SurfaceProjector::closest,
+/// warm-started at the particle's surface point) then puts it back on the surface. The fixed point
+/// is eq. 8's equilibrium sum_j w_j T_i(x_i - x_j) = 0.
+///
+/// Boundary particles slide along the boundary curve only: the same force's component along the
+/// curve tangent changes their arc-length parameter s, clamped so that they never pass a neighbour;
+/// their positions stay on the curve's chords (boundary_sampler.h) and `boundary_parameter`
+/// follows.
+///
+/// A move that would invert or nearly collapse a face (a corner whose sine, measured against the
+/// surface normal at that corner, drops to <= `min_corner_sine` and below its previous value) is
+/// halved once and otherwise rejected for that iteration; moves are accepted particle by particle
+/// in index order, so the result does not depend on the number of threads.
+///
+/// Iterations stop when the largest move is below `tolerance` times the mean spring length, after
+/// `max_iterations`, or when the progress callback asks to stop. Springs' rest values are rebuilt
+/// on the final positions (ParticleGrid::build_springs). Source UVs (when present) are
+/// re-interpolated from the region's vertex texture coordinates at each particle's new surface
+/// point.
+///
+/// Note on convergence: a Jacobi step diffuses information by about one grid ring, so reaching the
+/// full equilibrium takes O(n^2) steps on an n x n grid. Moderate grids (thousands of particles)
+/// converge within the default budget; larger ones get the local adaptation of `max_iterations`
+/// steps.
+
+#include <cstdint>
+
+#include "elastic/core/progress.h"
+#include "elastic/particles/particle_grid.h"
+#include "elastic/projection/closest_point.h"
+#include "elastic/regions/region.h"
+
+namespace elastic {
+
+struct AdaptiveSamplingOptions {
+  /// Weight floor as a fraction of the mean curvature weight (see the file comment); 0 is the
+  /// paper's bare weighting. Must be >= 0.
+  double floor = 0.05;
+  /// Fraction of the Jacobi displacement applied per iteration, in (0, 1].
+  double relaxation = 0.8;
+  /// Iteration budget.
+  int max_iterations = 300;
+  /// Converged when the largest move is below this fraction of the mean spring length.
+  double tolerance = 1e-3;
+  /// Let boundary particles slide along the curve (false keeps them at equal arc length).
+  bool move_boundary = true;
+  /// Smallest accepted corner sine of a face, against the surface normal (guards against
+  /// inversion).
+  double min_corner_sine = 0.05;
+  /// Random tangent displacement of the interior particles before relaxing, as a fraction of the
+  /// mean spring length (0: none). Makes the start a perturbed grid; deterministic for a given
+  /// seed.
+  double jitter = 0.0;
+  /// Seed of the jitter.
+  std::uint64_t seed = 0;
+  /// Called once per iteration (stage "adaptive sampling", gradient = largest move / mean spring
+  /// length).
+  ProgressCallback progress;
+  /// Name used in error messages.
+  std::string name = "region";
+};
+
+struct AdaptiveSamplingResult {
+  ParticleGrid grid;       ///< the sampled grid (same connectivity as the input, springs rebuilt)
+  int iterations = 0;      ///< Jacobi iterations done
+  double max_move = 0.0;   ///< largest move of the last iteration / mean spring length
+  bool converged = false;  ///< max_move fell below the tolerance
+  bool cancelled = false;  ///< the progress callback asked to stop
+  long rejected_moves =
+      0;  ///< moves rejected (not merely halved) to keep faces valid, all iterations
+  double mean_curvature_weight = 0.0;  ///< mean r over the particles at the end
+};
+
+/// Runs eq. 8 on `grid` (laid out on `region`, whose surface is `projector.surface()`).
+/// \throws InvalidInputError naming options.name when the options are out of range or the grid does
+/// not
+///         match the region (no source points, a boundary particle without parameter).
+AdaptiveSamplingResult adaptive_sampling(const ParticleGrid& grid, const Region& region,
+                                         const SurfaceProjector& projector,
+                                         const AdaptiveSamplingOptions& options = {});
+
+}  // namespace elastic
