@@ -1,12 +1,13 @@
 #pragma once
 /// \file
-/// A dense triangle tessellation of a limit surface whose every vertex knows its SurfacePoint. It serves
-/// the closest-point BVH (projection/), geodesics and region cutting (regions/) and rendering.
+/// A dense triangle tessellation of a limit surface whose every vertex knows its SurfacePoint. It
+/// serves the closest-point BVH (projection/), geodesics and region cutting (regions/) and
+/// rendering.
 ///
-/// The tessellation is watertight and welded: a vertex on an edge shared by two ptex faces is one vertex
-/// (its `points` entry uses one of the faces), so the result has the topology of the control mesh (same
-/// boundary loops, same genus). Vertex positions lie exactly on the limit surface; triangles are wound
-/// like the control mesh.
+/// The tessellation is watertight and welded: a vertex on an edge shared by two ptex faces is one
+/// vertex (its `points` entry uses one of the faces), so the result has the topology of the control
+/// mesh (same boundary loops, same genus). Vertex positions lie exactly on the limit surface;
+/// triangles are wound like the control mesh.
 
 #include <Eigen/Core>
 #include <vector>
@@ -16,19 +17,23 @@
 namespace elastic {
 
 struct TessellationOptions {
-  /// Segments along each ptex-face edge (each ptex quad becomes resolution^2 * 2 triangles, each Loop
-  /// triangle resolution^2 triangles). Used when `target_triangles` is 0. 1..1024.
+  /// Segments along each control-mesh edge: each control quad becomes resolution^2 * 2 triangles,
+  /// each Loop triangle resolution^2 triangles, and each of an n-gon's n ptex sub-faces (whose
+  /// edges are half control edges) (resolution/2)^2 * 2 triangles. Under Catmull-Clark with
+  /// non-quad faces an odd resolution is rounded up to the next even one. Used when
+  /// `target_triangles` is 0. 1..1024.
   int resolution = 8;
-  /// When > 0, choose the resolution so that the tessellation has about this many triangles.
+  /// When > 0, choose the resolution (within 1..1024) so that the tessellation has about this many
+  /// triangles.
   long target_triangles = 0;
 };
 
 struct LimitTessellation {
-  std::vector<Eigen::Vector3d> positions;    ///< #V limit positions
-  std::vector<SurfacePoint> points;          ///< #V surface point of each vertex
-  std::vector<Eigen::Vector3i> triangles;    ///< #T vertex triples, counter-clockwise
-  std::vector<int> triangle_face;            ///< #T ptex face each triangle lies in
-  int resolution = 0;                        ///< the resolution used
+  std::vector<Eigen::Vector3d> positions;  ///< #V limit positions
+  std::vector<SurfacePoint> points;        ///< #V surface point of each vertex
+  std::vector<Eigen::Vector3i> triangles;  ///< #T vertex triples, counter-clockwise
+  std::vector<int> triangle_face;          ///< #T ptex face each triangle lies in
+  int resolution = 0;                      ///< the resolution used
 };
 
 /// Tessellates `surface` uniformly in each ptex face's parameter domain.
