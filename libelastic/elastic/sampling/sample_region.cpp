@@ -1,5 +1,6 @@
 #include "elastic/sampling/sample_region.h"
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 
