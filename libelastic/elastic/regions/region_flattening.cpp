@@ -1,0 +1,246 @@
+#include "elastic/regions/region_flattening.h"
+
+#include <Eigen/SparseCholesky>
+#include <Eigen/SparseCore>
+#include <Eigen/SparseLU>
+#include <cmath>
+#include <numbers>
+
+#include "elastic/core/error.h"
+
+namespace elastic {
+namespace {
+
+using Triplets = std::vector<Eigen::Triplet<double>>;
+
+std::string region_name(const Region& region) {
+  return region.surface ? region.surface->name() + " region" : std::string("region");
+}
+
+int count_folds(const Region& region, const std::vector<Eigen::Vector2d>& uv) {
+  int folds = 0;
+  for (const Eigen::Vector3i& t : region.triangles) {
+    const Eigen::Vector2d a = uv[static_cast<size_t>(t[1])] - uv[static_cast<size_t>(t[0])];
+    const Eigen::Vector2d b = uv[static_cast<size_t>(t[2])] - uv[static_cast<size_t>(t[0])];
+    if (a.x() * b.y() - a.y() * b.x() <= 0.0) ++folds;
+  }
+  return folds;
+}
+
+/// Floater's mean-value coordinates (Floater 2003, "Mean value coordinates", CAGD 20(1)):
+/// w_ij = (tan(alpha_ij / 2) + tan(beta_ij / 2)) / |x_i - x_j|, alpha and beta the angles at x_i of
+/// the two triangles sharing edge ij. Every weight is positive, so with the boundary on a convex
+/// polygon (the unit circle) the map is a bijection onto it (Floater's theorem, Tutte's in the
+/// limit).
+RegionFlattening flatten_disk(const Region& region) {
+  const int nv = region.num_vertices();
+  const std::string name = region_name(region);
+  std::vector<int> index(static_cast<size_t>(nv), -1);
+  std::vector<Eigen::Vector2d> uv(static_cast<size_t>(nv), Eigen::Vector2d::Zero());
+  // Boundary on the unit circle at normalised arc length, angle 0 at the anchor, counter-clockwise.
+  const SurfaceCurve curve = region.boundary_curve();
+  const std::vector<double> cum = curve.arc_lengths();
+  const double total = curve.length();
+  if (!(total > 0.0)) throw NumericalError(name, "flattening: the boundary has zero length");
+  for (size_t k = 0; k < region.boundary.size(); ++k) {
+    const double angle = 2.0 * std::numbers::pi * (cum[k] / total - region.anchor);
+    uv[static_cast<size_t>(region.boundary[k])] = Eigen::Vector2d(std::cos(angle), std::sin(angle));
+    index[static_cast<size_t>(region.boundary[k])] = -2;
+  }
+  int free = 0;
+  for (int v = 0; v < nv; ++v) {
+    if (index[static_cast<size_t>(v)] == -1) index[static_cast<size_t>(v)] = free++;
+  }
+  RegionFlattening out;
+  out.method = FlatteningMethod::Disk;
+  if (free > 0) {
+    Triplets trip;
+    Eigen::MatrixXd rhs = Eigen::MatrixXd::Zero(free, 2);
+    for (const Eigen::Vector3i& t : region.triangles) {
+      for (int k = 0; k < 3; ++k) {
+        const int i = t[k], j = t[(k + 1) % 3], l = t[(k + 2) % 3];
+        const Eigen::Vector3d& xi = region.positions[static_cast<size_t>(i)];
+        const Eigen::Vector3d eij = region.positions[static_cast<size_t>(j)] - xi;
+        const Eigen::Vector3d eil = region.positions[static_cast<size_t>(l)] - xi;
+        const double lij = eij.norm(), lil = eil.norm();
+        if (lij == 0.0 || lil == 0.0) continue;
+        // tan(a/2) = (1 - cos a) / sin a = |e1 x e2| ... written as (|e1||e2| - e1.e2) / |e1 x e2|.
+        const double cross = eij.cross(eil).norm();
+        if (cross == 0.0) continue;
+        const double tan_half = (lij * lil - eij.dot(eil)) / cross;
+        const int ri = index[static_cast<size_t>(i)];
+        if (ri < 0) continue;
+        // The angle at i in this triangle contributes to the weights of both edges (i,j) and (i,l).
+        for (const auto& [other, len] : {std::pair{j, lij}, std::pair{l, lil}}) {
+          const double w = tan_half / len;
+          trip.emplace_back(ri, ri, w);
+          const int ro = index[static_cast<size_t>(other)];
+          if (ro >= 0) {
+            trip.emplace_back(ri, ro, -w);
+          } else {
+            rhs.row(ri) += w * uv[static_cast<size_t>(other)].transpose();
+          }
+        }
+      }
+    }
+    Eigen::SparseMatrix<double> a(free, free);
+    a.setFromTriplets(trip.begin(), trip.end());
+    Eigen::SparseLU<Eigen::SparseMatrix<double>> solver;
+    solver.compute(a);
+    if (solver.info() != Eigen::Success) {
+      throw NumericalError(name, "flattening: the mean-value system is singular");
+    }
+    const Eigen::MatrixXd x = solver.solve(rhs);
+    if (solver.info() != Eigen::Success || !x.allFinite()) {
+      throw NumericalError(name, "flattening: the mean-value solve failed");
+    }
+    for (int v = 0; v < nv; ++v) {
+      const int r = index[static_cast<size_t>(v)];
+      if (r >= 0) uv[static_cast<size_t>(v)] = x.row(r).transpose();
+    }
+  }
+  out.uv = std::move(uv);
+  out.folded_triangles = count_folds(region, out.uv);
+  return out;
+}
+
+/// Least-squares conformal map (Lévy et al. 2002), written as E_C = E_D - A (Desbrun et al. 2002;
+/// Mullen et al. 2008): the Dirichlet energy 1/2 sum_edges w_ij |U_i - U_j|^2 (cotangent weights
+/// w_ij = (cot a + cot b) / 2) minus the signed area of the image, 1/2 sum over boundary edges (i
+/// -> j, counter-clockwise) of (u_i v_j - u_j v_i). E_C >= 0 and vanishes exactly on conformal
+/// maps. Two boundary vertices (at the anchor and half the boundary length away) are pinned to
+/// remove the similarity freedom; the result is then scaled to the region's 3D area.
+RegionFlattening flatten_conformal(const Region& region) {
+  const int nv = region.num_vertices();
+  const std::string name = region_name(region);
+  const SurfaceCurve curve = region.boundary_curve();
+  const auto nb = static_cast<int>(region.boundary.size());
+  if (nb < 3) throw NumericalError(name, "flattening: the boundary has fewer than 3 vertices");
+  const std::vector<double> cum = curve.arc_lengths();
+  const double total = curve.length();
+  auto nearest_vertex = [&](double s) {
+    double target = s - std::floor(s);
+    int best = 0;
+    double best_d = 2.0;
+    for (int k = 0; k < nb; ++k) {
+      double d = std::abs(cum[static_cast<size_t>(k)] / total - target);
+      d = std::min(d, 1.0 - d);
+      if (d < best_d) {
+        best_d = d;
+        best = k;
+      }
+    }
+    return region.boundary[static_cast<size_t>(best)];
+  };
+  const int pin0 = nearest_vertex(region.anchor);
+  int pin1 = nearest_vertex(region.anchor + 0.5);
+  if (pin1 == pin0) pin1 = region.boundary[static_cast<size_t>(1)];
+  const double pin_distance =
+      (region.positions[static_cast<size_t>(pin1)] - region.positions[static_cast<size_t>(pin0)])
+          .norm();
+
+  // Unknowns: u of every vertex then v of every vertex; the quadratic form is x^T Q x.
+  Triplets q;
+  for (const Eigen::Vector3i& t : region.triangles) {
+    for (int k = 0; k < 3; ++k) {
+      const int i = t[k], j = t[(k + 1) % 3], l = t[(k + 2) % 3];
+      const Eigen::Vector3d a =
+          region.positions[static_cast<size_t>(i)] - region.positions[static_cast<size_t>(l)];
+      const Eigen::Vector3d b =
+          region.positions[static_cast<size_t>(j)] - region.positions[static_cast<size_t>(l)];
+      const double cross = a.cross(b).norm();
+      if (cross == 0.0) continue;
+      // Edge (i, j) opposite corner l: 1/2 cot(l) (|u_i - u_j|^2 + |v_i - v_j|^2) enters E_D with
+      // 1/2.
+      const double w = 0.25 * a.dot(b) / cross;
+      for (int c = 0; c < 2; ++c) {
+        const int oi = i + c * nv, oj = j + c * nv;
+        q.emplace_back(oi, oi, w);
+        q.emplace_back(oj, oj, w);
+        q.emplace_back(oi, oj, -w);
+        q.emplace_back(oj, oi, -w);
+      }
+    }
+  }
+  for (int k = 0; k < nb; ++k) {
+    const int i = region.boundary[static_cast<size_t>(k)];
+    const int j = region.boundary[static_cast<size_t>((k + 1) % nb)];
+    // -1/2 (u_i v_j - u_j v_i), symmetrised.
+    q.emplace_back(i, j + nv, -0.25);
+    q.emplace_back(j + nv, i, -0.25);
+    q.emplace_back(j, i + nv, 0.25);
+    q.emplace_back(i + nv, j, 0.25);
+  }
+  Eigen::SparseMatrix<double> full(2 * nv, 2 * nv);
+  full.setFromTriplets(q.begin(), q.end());
+  std::vector<int> index(static_cast<size_t>(2 * nv), -1);
+  Eigen::VectorXd fixed = Eigen::VectorXd::Zero(2 * nv);
+  fixed[pin1] = pin_distance;  // pin0 at (0, 0), pin1 at (d, 0)
+  int free = 0;
+  for (int r = 0; r < 2 * nv; ++r) {
+    const int v = r % nv;
+    if (v != pin0 && v != pin1) index[static_cast<size_t>(r)] = free++;
+  }
+  Triplets reduced;
+  Eigen::VectorXd rhs = Eigen::VectorXd::Zero(free);
+  for (int c = 0; c < full.outerSize(); ++c) {
+    for (Eigen::SparseMatrix<double>::InnerIterator it(full, c); it; ++it) {
+      const int r = index[static_cast<size_t>(it.row())], cc = index[static_cast<size_t>(it.col())];
+      if (r < 0) continue;
+      if (cc >= 0) {
+        reduced.emplace_back(r, cc, it.value());
+      } else {
+        rhs[r] -= it.value() * fixed[it.col()];
+      }
+    }
+  }
+  Eigen::SparseMatrix<double> a(free, free);
+  a.setFromTriplets(reduced.begin(), reduced.end());
+  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver(a);
+  if (solver.info() != Eigen::Success)
+    throw NumericalError(name, "flattening: the LSCM system is singular");
+  const Eigen::VectorXd x = solver.solve(rhs);
+  if (solver.info() != Eigen::Success || !x.allFinite()) {
+    throw NumericalError(name, "flattening: the LSCM solve failed");
+  }
+  std::vector<Eigen::Vector2d> uv(static_cast<size_t>(nv));
+  for (int v = 0; v < nv; ++v) {
+    for (int c = 0; c < 2; ++c) {
+      const int r = v + c * nv;
+      uv[static_cast<size_t>(v)][c] =
+          index[static_cast<size_t>(r)] >= 0 ? x[index[static_cast<size_t>(r)]] : fixed[r];
+    }
+  }
+  // Scale to the 3D area (the pin distance only fixes the scale approximately).
+  double area2d = 0.0;
+  for (const Eigen::Vector3i& t : region.triangles) {
+    const Eigen::Vector2d e1 = uv[static_cast<size_t>(t[1])] - uv[static_cast<size_t>(t[0])];
+    const Eigen::Vector2d e2 = uv[static_cast<size_t>(t[2])] - uv[static_cast<size_t>(t[0])];
+    area2d += 0.5 * (e1.x() * e2.y() - e1.y() * e2.x());
+  }
+  if (area2d > 0.0) {
+    const double s = std::sqrt(region.area() / area2d);
+    for (auto& p : uv) p *= s;
+  }
+  RegionFlattening out;
+  out.uv = std::move(uv);
+  out.method = FlatteningMethod::Conformal;
+  out.folded_triangles = count_folds(region, out.uv);
+  return out;
+}
+
+}  // namespace
+
+RegionFlattening flatten_region(const Region& region, const FlatteningOptions& options) {
+  if (region.triangles.empty() || region.boundary.size() < 3) {
+    throw InvalidInputError(region_name(region), "flattening: the region is empty");
+  }
+  if (options.method == FlatteningMethod::Conformal) {
+    RegionFlattening conformal = flatten_conformal(region);
+    if (conformal.folded_triangles == 0) return conformal;
+    // Folded: fall back to the always-bijective disk map (method says which one was used).
+  }
+  return flatten_disk(region);
+}
+
+}  // namespace elastic

@@ -1,0 +1,607 @@
+#include "elastic/regions/region_spec.h"
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <limits>
+#include <sstream>
+
+#include "elastic/core/error.h"
+#include "elastic/projection/closest_point.h"
+#include "elastic/regions/cut_mesh.h"
+#include "elastic/regions/heat_geodesics.h"
+
+namespace elastic {
+namespace {
+
+using regions_detail::Chart;
+using regions_detail::CutMesh;
+using regions_detail::MeshLocation;
+using regions_detail::PatchTopology;
+
+/// Crossings and curve points closer than this (in barycentric terms of the triangle being cut) to
+/// a vertex or an edge are moved onto it, so that cutting never leaves sliver triangles.
+constexpr double kSnap = 1e-3;
+
+std::string trim(std::string_view s) {
+  const auto b = s.find_first_not_of(" \t\r\n");
+  if (b == std::string_view::npos) return {};
+  const auto e = s.find_last_not_of(" \t\r\n");
+  return std::string(s.substr(b, e - b + 1));
+}
+
+std::vector<double> parse_numbers(const std::string& text, const std::string& flag,
+                                  const std::string& what) {
+  std::vector<double> out;
+  std::stringstream ss(text);
+  std::string item;
+  while (std::getline(ss, item, ',')) {
+    const std::string t = trim(item);
+    size_t used = 0;
+    double value = 0.0;
+    try {
+      value = std::stod(t, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (t.empty() || used != t.size() || !std::isfinite(value)) {
+      throw InvalidInputError(flag, what + ": '" + t + "' is not a finite number");
+    }
+    out.push_back(value);
+  }
+  return out;
+}
+
+/// Reads rows of `columns` numbers (blank lines and '#' comments skipped).
+std::vector<Eigen::VectorXd> read_rows(const std::string& path, int columns) {
+  std::ifstream in(path);
+  if (!in) throw IoError(path, "cannot open the file");
+  std::vector<Eigen::VectorXd> rows;
+  std::string line;
+  int number = 0;
+  while (std::getline(in, line)) {
+    ++number;
+    const auto hash = line.find('#');
+    if (hash != std::string::npos) line.erase(hash);
+    if (trim(line).empty()) continue;
+    std::istringstream ls(line);
+    Eigen::VectorXd row(columns);
+    for (int c = 0; c < columns; ++c) {
+      std::string token;
+      if (!(ls >> token)) {
+        throw InvalidInputError(path, "line " + std::to_string(number) + ": expected " +
+                                          std::to_string(columns) + " numbers");
+      }
+      size_t used = 0;
+      double value = 0.0;
+      try {
+        value = std::stod(token, &used);
+      } catch (const std::exception&) {
+        used = 0;
+      }
+      if (used != token.size() || !std::isfinite(value)) {
+        throw InvalidInputError(
+            path, "line " + std::to_string(number) + ": '" + token + "' is not a finite number");
+      }
+      row[c] = value;
+    }
+    std::string extra;
+    if (ls >> extra) {
+      throw InvalidInputError(path, "line " + std::to_string(number) + ": expected " +
+                                        std::to_string(columns) + " numbers, found more");
+    }
+    rows.push_back(row);
+  }
+  if (in.bad()) throw IoError(path, "read error");
+  return rows;
+}
+
+/// Everything make_region needs about the surface's tessellation.
+struct Context {
+  const SurfaceProjector& projector;
+  const LimitSurface& surface;
+  const LimitTessellation& tess;
+  const RegionOptions& options;
+  std::vector<std::array<Eigen::Vector2d, 3>> corner_uv;
+  std::vector<std::vector<int>> face_triangles;
+  double diagonal = 0.0;
+
+  Context(const SurfaceProjector& p, const RegionOptions& o)
+      : projector(p), surface(p.surface()), tess(p.tessellation()), options(o) {
+    corner_uv = regions_detail::tessellation_corner_uv(surface, tess);
+    face_triangles.resize(static_cast<size_t>(surface.num_faces()));
+    for (size_t t = 0; t < tess.triangles.size(); ++t) {
+      face_triangles[static_cast<size_t>(tess.triangle_face[t])].push_back(static_cast<int>(t));
+    }
+    Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
+    Eigen::Vector3d hi = -lo;
+    for (const Eigen::Vector3d& x : tess.positions) {
+      lo = lo.cwiseMin(x);
+      hi = hi.cwiseMax(x);
+    }
+    diagonal = tess.positions.empty() ? 0.0 : (hi - lo).norm();
+  }
+
+  CutMesh cut_mesh() const { return CutMesh(surface, tess, corner_uv, options.name); }
+
+  /// The tessellation triangle holding a surface point, with barycentric coordinates.
+  MeshLocation locate(const SurfacePoint& p) const {
+    MeshLocation best;
+    double best_min = -std::numeric_limits<double>::infinity();
+    for (int t : face_triangles[static_cast<size_t>(p.face)]) {
+      const Eigen::Vector3d b =
+          regions_detail::barycentric_2d(corner_uv[static_cast<size_t>(t)], p.uv());
+      if (b.isZero()) continue;
+      if (b.minCoeff() > best_min) {
+        best_min = b.minCoeff();
+        best = MeshLocation{t, b};
+      }
+    }
+    if (best.triangle < 0)
+      throw NumericalError(options.name, "internal: cannot locate a surface point");
+    Eigen::Vector3d b = best.bary.cwiseMax(0.0);
+    for (int k = 0; k < 3; ++k) b[k] = b[k] < 1e-9 ? 0.0 : b[k];
+    best.bary = b / b.sum();
+    return best;
+  }
+
+  /// Projects a user point onto the surface; error when it is far from it.
+  MeshLocation project(const Eigen::Vector3d& x, const std::string& what) const {
+    if (!x.allFinite()) throw InvalidInputError(options.name, what + " is not finite");
+    const ClosestPoint cp = projector.closest(x);
+    if (cp.distance > options.max_point_distance * diagonal) {
+      std::ostringstream msg;
+      msg << what << " (" << x.x() << ", " << x.y() << ", " << x.z()
+          << ") is far from the surface (" << cp.distance << " away, more than "
+          << options.max_point_distance << " of the bounding-box diagonal)";
+      throw InvalidInputError(options.name, msg.str());
+    }
+    return locate(cp.point);
+  }
+};
+
+[[noreturn]] void throw_not_disk(const std::string& name) {
+  throw InvalidInputError(name, "the region is not a disk (it holds a handle or a hole)");
+}
+
+/// After a closed curve has been embedded: the side of it that is a disk (the smaller one by area
+/// when both are).
+Region pick_disk_side(const CutMesh& cut, const std::string& name) {
+  const auto comps = cut.components();
+  int best = -1;
+  PatchTopology best_topo;
+  int touching = 0;
+  for (size_t c = 0; c < comps.size(); ++c) {
+    bool adjacent = false;
+    for (int t : comps[c]) {
+      const Eigen::Vector3i& v = cut.triangles[static_cast<size_t>(t)];
+      for (int k = 0; k < 3 && !adjacent; ++k) adjacent = cut.is_curve_edge(v[k], v[(k + 1) % 3]);
+      if (adjacent) break;
+    }
+    if (!adjacent) continue;
+    ++touching;
+    PatchTopology topo = regions_detail::patch_topology(cut, comps[c]);
+    if (!topo.is_disk()) continue;
+    if (best < 0 || topo.area < best_topo.area) {
+      best = static_cast<int>(c);
+      best_topo = std::move(topo);
+    }
+  }
+  if (best < 0 || touching < 2) throw_not_disk(name);
+  return regions_detail::make_region_from_patch(cut, comps[static_cast<size_t>(best)], best_topo);
+}
+
+Region disk_region(const Context& ctx, const RegionSpec& spec) {
+  const std::string& name = ctx.options.name;
+  if (!(spec.radius > 0.0) || !std::isfinite(spec.radius)) {
+    throw InvalidInputError(name,
+                            "disk radius " + std::to_string(spec.radius) + " must be positive");
+  }
+  const MeshLocation centre = ctx.project(spec.center, "disk centre");
+  const regions_detail::HeatGeodesics heat(ctx.tess.positions, ctx.tess.triangles, name);
+  const Eigen::VectorXd distance = heat.distance(centre);
+  CutMesh cut = ctx.cut_mesh();
+  // Level set phi = distance - R, cut exactly: every edge whose ends have opposite signs is split
+  // where the linear interpolant vanishes. Crossings within kSnap of an end move to that end (phi
+  // := 0 there).
+  std::vector<double> phi(distance.data(), distance.data() + distance.size());
+  for (double& p : phi) p -= spec.radius;
+  const std::vector<double> raw = phi;
+  std::vector<std::pair<int, int>> edges;
+  for (const Eigen::Vector3i& t : ctx.tess.triangles) {
+    for (int k = 0; k < 3; ++k) {
+      const int a = t[k], b = t[(k + 1) % 3];
+      if (a < b) edges.emplace_back(a, b);
+      // Boundary edges appear once, in one direction only.
+      else if (cut.edge_triangles(a, b).size() == 1)
+        edges.emplace_back(b, a);
+    }
+  }
+  std::sort(edges.begin(), edges.end());
+  edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
+  std::vector<char> zero(phi.size(), 0);
+  for (const auto& [a, b] : edges) {
+    const double pa = phi[static_cast<size_t>(a)], pb = phi[static_cast<size_t>(b)];
+    if (!((pa < 0.0 && pb > 0.0) || (pa > 0.0 && pb < 0.0))) continue;
+    const double t = pa / (pa - pb);
+    if (t < kSnap) zero[static_cast<size_t>(a)] = 1;
+    if (t > 1.0 - kSnap) zero[static_cast<size_t>(b)] = 1;
+  }
+  for (size_t i = 0; i < phi.size(); ++i) {
+    if (zero[i]) phi[i] = 0.0;
+  }
+  for (const auto& [a, b] : edges) {
+    const double pa = phi[static_cast<size_t>(a)], pb = phi[static_cast<size_t>(b)];
+    if (!((pa < 0.0 && pb > 0.0) || (pa > 0.0 && pb < 0.0))) continue;
+    cut.split_edge(a, b, pa / (pa - pb));
+    phi.push_back(0.0);
+  }
+  // Every triangle is now on one side: inside when no corner is positive (all-zero triangles, on
+  // the level set itself, go by the unsnapped field).
+  std::vector<char> inside(static_cast<size_t>(cut.num_triangles()), 0);
+  for (int t = 0; t < cut.num_triangles(); ++t) {
+    const Eigen::Vector3i& v = cut.triangles[static_cast<size_t>(t)];
+    double max_phi = -std::numeric_limits<double>::infinity(), raw_sum = 0.0;
+    for (int k = 0; k < 3; ++k) {
+      max_phi = std::max(max_phi, phi[static_cast<size_t>(v[k])]);
+      if (static_cast<size_t>(v[k]) < raw.size()) raw_sum += raw[static_cast<size_t>(v[k])];
+    }
+    inside[static_cast<size_t>(t)] = max_phi < 0.0;
+    if (max_phi == 0.0) {
+      bool any_negative = false;
+      for (int k = 0; k < 3; ++k)
+        any_negative = any_negative || phi[static_cast<size_t>(v[k])] < 0.0;
+      inside[static_cast<size_t>(t)] = any_negative || raw_sum < 0.0;
+    }
+  }
+  // The component of the sub-level set around the centre (the discrete field may have far-away
+  // dips).
+  const auto comps = cut.components(&inside);
+  int chosen = -1;
+  for (size_t c = 0; c < comps.size() && chosen < 0; ++c) {
+    for (int t : comps[c]) {
+      if (cut.origin[static_cast<size_t>(t)] == centre.triangle) {
+        chosen = static_cast<int>(c);
+        break;
+      }
+    }
+  }
+  if (chosen < 0) {
+    throw InvalidInputError(name, "the disk of radius " + std::to_string(spec.radius) +
+                                      " is too small for the surface's tessellation (edges about " +
+                                      std::to_string(heat.mean_edge_length()) + " long)");
+  }
+  PatchTopology topo = regions_detail::patch_topology(cut, comps[static_cast<size_t>(chosen)]);
+  if (topo.loops.empty()) {
+    throw InvalidInputError(name, "the disk of radius " + std::to_string(spec.radius) +
+                                      " covers the whole closed surface");
+  }
+  if (!topo.is_disk()) throw_not_disk(name);
+  return regions_detail::make_region_from_patch(cut, comps[static_cast<size_t>(chosen)], topo);
+}
+
+/// Embeds a closed chain of curve points (each a location in a tessellation triangle that also
+/// holds the next point) and walks the straight segments between them in `chart`.
+void embed_curve(CutMesh& cut, const std::vector<MeshLocation>& nodes, Chart chart,
+                 const std::vector<Eigen::Vector2d>* chart_points) {
+  std::vector<int> verts;
+  std::vector<int> seg;  // tessellation triangle holding vertex i and i+1 (ptex chart)
+  std::vector<Eigen::Vector2d> coords;
+  for (size_t i = 0; i < nodes.size(); ++i) {
+    const MeshLocation& n = nodes[i];
+    int v = -1;
+    Eigen::Vector2d c = Eigen::Vector2d::Zero();
+    if (chart == Chart::Ptex) {
+      const Eigen::Vector2d uv =
+          regions_detail::interpolate(cut.uv[static_cast<size_t>(n.triangle)], n.bary);
+      v = cut.insert_point(n.triangle, uv, kSnap);
+    } else {
+      // Texture chart: locate the polygon point among the current triangles (earlier insertions may
+      // have split the one it was found in).
+      const Eigen::Vector2d& p = (*chart_points)[i];
+      int best_t = -1;
+      double best_min = -std::numeric_limits<double>::infinity();
+      Eigen::Vector3d best_b = Eigen::Vector3d::Zero();
+      for (int t = 0; t < cut.num_triangles(); ++t) {
+        const Eigen::Vector3d b =
+            regions_detail::barycentric_2d(cut.tex[static_cast<size_t>(t)], p);
+        if (!b.isZero() && b.minCoeff() > best_min) {
+          best_min = b.minCoeff();
+          best_t = t;
+          best_b = b;
+        }
+      }
+      best_b = best_b.cwiseMax(0.0);
+      v = cut.insert_in_triangle(best_t, best_b / best_b.sum(), kSnap);
+    }
+    if (!verts.empty() && v == verts.back()) {
+      seg.back() = n.triangle;  // merged: the next segment runs in this node's triangle
+      continue;
+    }
+    if (cut.on_curve[static_cast<size_t>(v)]) cut.throw_crossing();
+    cut.on_curve[static_cast<size_t>(v)] = 1;
+    verts.push_back(v);
+    seg.push_back(n.triangle);
+    // Chart coordinate of the new vertex: ptex (u, v) in the segment's face, or the texture
+    // coordinate nearest the polygon's own point (several at a seam).
+    double best = std::numeric_limits<double>::infinity();
+    const Eigen::Vector2d want = chart_points ? (*chart_points)[i] : Eigen::Vector2d::Zero();
+    for (int t : cut.vertex_triangles[static_cast<size_t>(v)]) {
+      if (chart == Chart::Ptex) {
+        if (cut.face[static_cast<size_t>(t)] != cut.face[static_cast<size_t>(n.triangle)]) continue;
+        c = cut.chart_coordinate(chart, t, v);
+        best = 0.0;
+        break;
+      }
+      const Eigen::Vector2d cc = cut.chart_coordinate(chart, t, v);
+      if ((cc - want).squaredNorm() < best) {
+        best = (cc - want).squaredNorm();
+        c = cc;
+      }
+    }
+    coords.push_back(c);
+  }
+  if (verts.size() > 1 && verts.back() == verts.front()) {
+    verts.pop_back();
+    seg.pop_back();
+    coords.pop_back();
+  }
+  if (verts.size() < 3) {
+    throw InvalidInputError(cut.surface().name(),
+                            "the curve is degenerate (fewer than 3 distinct points)");
+  }
+  for (size_t i = 0; i < verts.size(); ++i) {
+    const size_t j = (i + 1) % verts.size();
+    const int face = chart == Chart::Ptex ? cut.face[static_cast<size_t>(seg[i])] : -1;
+    cut.walk(verts[i], coords[i], verts[j], chart, face, kSnap);
+  }
+}
+
+Region points_region(const Context& ctx, const RegionSpec& spec) {
+  const std::string& name = ctx.options.name;
+  std::vector<MeshLocation> locs;
+  std::vector<Eigen::Vector3d> where;
+  for (size_t i = 0; i < spec.points.size(); ++i) {
+    const MeshLocation loc = ctx.project(spec.points[i], "point " + std::to_string(i + 1));
+    // Drop repeated points (consecutive, or the last equal to the first).
+    Eigen::Vector3d x = Eigen::Vector3d::Zero();
+    for (int k = 0; k < 3; ++k) {
+      x += loc.bary[k] * ctx.tess.positions[static_cast<size_t>(
+                             ctx.tess.triangles[static_cast<size_t>(loc.triangle)][k])];
+    }
+    if (!where.empty() && (x - where.back()).norm() <= 1e-9 * ctx.diagonal) continue;
+    where.push_back(x);
+    locs.push_back(loc);
+  }
+  if (where.size() > 1 && (where.back() - where.front()).norm() <= 1e-9 * ctx.diagonal) {
+    where.pop_back();
+    locs.pop_back();
+  }
+  if (locs.size() < 3) {
+    throw InvalidInputError(name,
+                            "the curve needs at least 3 distinct points on the surface, got " +
+                                std::to_string(locs.size()));
+  }
+  const regions_detail::HeatGeodesics heat(ctx.tess.positions, ctx.tess.triangles, name);
+  std::vector<MeshLocation> nodes;
+  for (size_t i = 0; i < locs.size(); ++i) {
+    const auto path = heat.trace_path(locs[i], locs[(i + 1) % locs.size()]);
+    for (const auto& node : path) {
+      // Express the node in the triangle that holds the segment leaving it.
+      MeshLocation m{node.segment_triangle, Eigen::Vector3d::Zero()};
+      const Eigen::Vector3i& from = ctx.tess.triangles[static_cast<size_t>(node.location.triangle)];
+      const Eigen::Vector3i& to = ctx.tess.triangles[static_cast<size_t>(node.segment_triangle)];
+      for (int k = 0; k < 3; ++k) {
+        for (int l = 0; l < 3; ++l) {
+          if (to[l] == from[k]) m.bary[l] += node.location.bary[k];
+        }
+      }
+      m.bary /= m.bary.sum();
+      nodes.push_back(m);
+    }
+  }
+  CutMesh cut = ctx.cut_mesh();
+  embed_curve(cut, nodes, Chart::Ptex, nullptr);
+  return pick_disk_side(cut, name);
+}
+
+Region boundary_region(const Context& ctx) {
+  CutMesh cut = ctx.cut_mesh();
+  std::vector<int> all(static_cast<size_t>(cut.num_triangles()));
+  for (int t = 0; t < cut.num_triangles(); ++t) all[static_cast<size_t>(t)] = t;
+  const PatchTopology topo = regions_detail::patch_topology(cut, all);
+  if (topo.loops.size() != 1) {
+    throw InvalidInputError(ctx.options.name,
+                            "'boundary' needs a surface with exactly one boundary loop; " +
+                                ctx.surface.name() + " has " + std::to_string(topo.loops.size()));
+  }
+  if (!topo.is_disk()) throw_not_disk(ctx.options.name);
+  return regions_detail::make_region_from_patch(cut, all, topo);
+}
+
+bool segments_cross(const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Eigen::Vector2d& c,
+                    const Eigen::Vector2d& d) {
+  auto orient = [](const Eigen::Vector2d& p, const Eigen::Vector2d& q, const Eigen::Vector2d& r) {
+    return (q.x() - p.x()) * (r.y() - p.y()) - (q.y() - p.y()) * (r.x() - p.x());
+  };
+  const double o1 = orient(a, b, c), o2 = orient(a, b, d), o3 = orient(c, d, a),
+               o4 = orient(c, d, b);
+  return ((o1 > 0) != (o2 > 0) || o1 == 0.0 || o2 == 0.0) &&
+         ((o3 > 0) != (o4 > 0) || o3 == 0.0 || o4 == 0.0);
+}
+
+Region uv_region(const Context& ctx, const RegionSpec& spec) {
+  const std::string& name = ctx.options.name;
+  if (!ctx.surface.control_mesh().has_texcoords()) {
+    throw InvalidInputError(
+        name, "uv: region on " + ctx.surface.name() + ", which has no texture coordinates");
+  }
+  std::vector<Eigen::Vector2d> poly;
+  for (const Eigen::Vector2d& p : spec.uv_polygon) {
+    if (!p.allFinite()) throw InvalidInputError(name, "uv polygon point is not finite");
+    if (poly.empty() || (p - poly.back()).norm() > 1e-12) poly.push_back(p);
+  }
+  if (poly.size() > 1 && (poly.back() - poly.front()).norm() <= 1e-12) poly.pop_back();
+  if (poly.size() < 3) {
+    throw InvalidInputError(name, "the uv polygon needs at least 3 distinct points, got " +
+                                      std::to_string(poly.size()));
+  }
+  const size_t n = poly.size();
+  for (size_t i = 0; i < n; ++i) {
+    for (size_t j = i + 1; j < n; ++j) {
+      if (j == i + 1 || (i == 0 && j == n - 1)) continue;  // neighbours share a corner
+      if (segments_cross(poly[i], poly[(i + 1) % n], poly[j], poly[(j + 1) % n])) {
+        throw InvalidInputError(name, "the curve crosses itself (uv polygon edges " +
+                                          std::to_string(i + 1) + " and " + std::to_string(j + 1) +
+                                          ")");
+      }
+    }
+  }
+  CutMesh cut = ctx.cut_mesh();
+  cut.enable_texture_chart();
+  std::vector<MeshLocation> nodes;
+  for (const Eigen::Vector2d& p : poly) {
+    MeshLocation best;
+    double best_min = -1e-9;
+    for (int t = 0; t < cut.num_triangles(); ++t) {
+      const Eigen::Vector3d b = regions_detail::barycentric_2d(cut.tex[static_cast<size_t>(t)], p);
+      if (b.isZero()) continue;
+      if (b.minCoeff() > best_min) {
+        best_min = b.minCoeff();
+        best = MeshLocation{t, b.cwiseMax(0.0) / b.cwiseMax(0.0).sum()};
+      }
+    }
+    if (best.triangle < 0) {
+      std::ostringstream msg;
+      msg << "uv polygon point (" << p.x() << ", " << p.y() << ") is outside the texture domain of "
+          << ctx.surface.name();
+      throw InvalidInputError(name, msg.str());
+    }
+    nodes.push_back(best);
+  }
+  embed_curve(cut, nodes, Chart::Texture, &poly);
+  return pick_disk_side(cut, name);
+}
+
+/// Automatic anchor: the boundary point in the direction, from the region's centroid, of the world
+/// axis least aligned with the region's mean normal (x before y before z on ties), projected onto
+/// the plane perpendicular to that normal. Deterministic, independent of the boundary's vertex
+/// numbering, and for two similarly placed regions it picks corresponding points.
+double automatic_anchor(const Region& region) {
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero(), normal = Eigen::Vector3d::Zero();
+  double area = 0.0;
+  for (const Eigen::Vector3i& t : region.triangles) {
+    const Eigen::Vector3d& a = region.positions[static_cast<size_t>(t[0])];
+    const Eigen::Vector3d& b = region.positions[static_cast<size_t>(t[1])];
+    const Eigen::Vector3d& c = region.positions[static_cast<size_t>(t[2])];
+    const Eigen::Vector3d n = (b - a).cross(c - a);
+    normal += n;
+    area += 0.5 * n.norm();
+    centroid += 0.5 * n.norm() * (a + b + c) / 3.0;
+  }
+  if (area > 0.0) centroid /= area;
+  Eigen::Vector3d reference = Eigen::Vector3d::UnitX();
+  if (normal.norm() > 1e-9 * area) {
+    const Eigen::Vector3d nn = normal.normalized();
+    int axis = 0;
+    nn.cwiseAbs().minCoeff(&axis);  // first index on ties
+    reference = Eigen::Vector3d::Unit(axis) - nn[axis] * nn;
+    reference.normalize();
+  }
+  const SurfaceCurve curve = region.boundary_curve();
+  double best = -std::numeric_limits<double>::infinity();
+  int best_v = 0;
+  for (int i = 0; i < curve.size(); ++i) {
+    const Eigen::Vector3d d = curve.positions[static_cast<size_t>(i)] - centroid;
+    const double norm = d.norm();
+    const double score = norm > 0.0 ? d.dot(reference) / norm : -1.0;
+    if (score > best + 1e-12) {
+      best = score;
+      best_v = i;
+    }
+  }
+  const std::vector<double> cum = curve.arc_lengths();
+  const double total = curve.length();
+  return total > 0.0 ? cum[static_cast<size_t>(best_v)] / total : 0.0;
+}
+
+}  // namespace
+
+RegionSpec parse_region_spec(std::string_view text_in, std::string_view flag_in) {
+  const std::string flag(flag_in);
+  RegionSpec spec;
+  spec.text = std::string(text_in);
+  std::string text = trim(text_in);
+  // Optional anchor suffix: "<spec>;anchor=X,Y,Z".
+  const auto semi = text.find(";anchor=");
+  if (semi != std::string::npos) {
+    const auto values = parse_numbers(text.substr(semi + 8), flag, "anchor");
+    if (values.size() != 3) throw InvalidInputError(flag, "anchor needs X,Y,Z");
+    spec.anchor = Eigen::Vector3d(values[0], values[1], values[2]);
+    text = trim(text.substr(0, semi));
+  }
+  const auto colon = text.find(':');
+  const std::string kind = colon == std::string::npos ? text : text.substr(0, colon);
+  const std::string arg = colon == std::string::npos ? std::string() : text.substr(colon + 1);
+  if (kind == "boundary" && colon == std::string::npos) {
+    spec.kind = RegionSpec::Kind::Boundary;
+  } else if (kind == "disk") {
+    const auto values = parse_numbers(arg, flag, "disk");
+    if (values.size() != 4) throw InvalidInputError(flag, "disk needs X,Y,Z,R, got '" + arg + "'");
+    spec.kind = RegionSpec::Kind::Disk;
+    spec.center = Eigen::Vector3d(values[0], values[1], values[2]);
+    spec.radius = values[3];
+    if (!(spec.radius > 0.0)) throw InvalidInputError(flag, "disk radius must be positive");
+  } else if (kind == "points") {
+    if (arg.empty()) throw InvalidInputError(flag, "points: needs a file name");
+    spec.kind = RegionSpec::Kind::Points;
+    for (const auto& row : read_rows(arg, 3)) spec.points.emplace_back(row[0], row[1], row[2]);
+    if (spec.points.size() < 3) {
+      throw InvalidInputError(arg, "a points curve needs at least 3 points, the file has " +
+                                       std::to_string(spec.points.size()));
+    }
+  } else if (kind == "uv") {
+    if (arg.empty()) throw InvalidInputError(flag, "uv: needs a file name");
+    spec.kind = RegionSpec::Kind::UvPolygon;
+    for (const auto& row : read_rows(arg, 2)) spec.uv_polygon.emplace_back(row[0], row[1]);
+    if (spec.uv_polygon.size() < 3) {
+      throw InvalidInputError(arg, "a uv polygon needs at least 3 points, the file has " +
+                                       std::to_string(spec.uv_polygon.size()));
+    }
+  } else {
+    throw InvalidInputError(flag,
+                            "unknown region '" + spec.text +
+                                "' (expected disk:X,Y,Z,R, points:FILE, boundary or uv:FILE)");
+  }
+  return spec;
+}
+
+Region make_region(const SurfaceProjector& projector, const RegionSpec& spec,
+                   const RegionOptions& options) {
+  const Context ctx(projector, options);
+  Region region;
+  switch (spec.kind) {
+    case RegionSpec::Kind::Disk:
+      region = disk_region(ctx, spec);
+      break;
+    case RegionSpec::Kind::Points:
+      region = points_region(ctx, spec);
+      break;
+    case RegionSpec::Kind::Boundary:
+      region = boundary_region(ctx);
+      break;
+    case RegionSpec::Kind::UvPolygon:
+      region = uv_region(ctx, spec);
+      break;
+  }
+  if (spec.anchor) {
+    if (!spec.anchor->allFinite()) throw InvalidInputError(options.name, "anchor is not finite");
+    region.anchor = region.boundary_curve().nearest_arc_parameter(*spec.anchor);
+  } else {
+    region.anchor = automatic_anchor(region);
+  }
+  return region;
+}
+
+}  // namespace elastic
