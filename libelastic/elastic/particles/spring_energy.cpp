@@ -1,0 +1,285 @@
+#include "elastic/particles/spring_energy.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
+
+#include <Eigen/Geometry>
+#include <cmath>
+#include <string>
+
+#include "elastic/core/error.h"
+
+namespace elastic {
+
+namespace {
+
+// Grain of the parallel loops. It is fixed (not derived from the thread count) so that the
+// deterministic reduction splits the sums the same way whatever the number of threads.
+constexpr std::size_t kGrain = 4096;
+
+bool finite_non_negative(double value) {
+  return std::isfinite(value) && value >= 0.0;
+}
+
+// Builds compressed-row incidence from (particle, entry) pairs given in a stable order.
+void build_incidence(int num_particles, const std::vector<std::pair<int, int>>& pairs,
+                     std::vector<int>& offset, std::vector<int>& entry) {
+  offset.assign(static_cast<std::size_t>(num_particles) + 1, 0);
+  for (const auto& [particle, code] : pairs) ++offset[static_cast<std::size_t>(particle) + 1];
+  for (std::size_t p = 0; p < static_cast<std::size_t>(num_particles); ++p)
+    offset[p + 1] += offset[p];
+  entry.resize(pairs.size());
+  std::vector<int> fill(offset.begin(), offset.end() - 1);
+  for (const auto& [particle, code] : pairs)
+    entry[static_cast<std::size_t>(fill[particle]++)] = code;
+}
+
+}  // namespace
+
+std::string_view to_string(RestScale mode) {
+  switch (mode) {
+    case RestScale::Boundary:
+      return "boundary";
+    case RestScale::Area:
+      return "area";
+    case RestScale::None:
+      return "none";
+  }
+  return "unknown";
+}
+
+RestScale parse_rest_scale(std::string_view text, std::string_view input) {
+  if (text == "boundary") return RestScale::Boundary;
+  if (text == "area") return RestScale::Area;
+  if (text == "none") return RestScale::None;
+  throw InvalidInputError(std::string(input), "unknown rest scale '" + std::string(text) +
+                                                  "' (expected boundary, area or none)");
+}
+
+double rest_scale_factor(RestScale mode, const RegionSizes& sizes) {
+  const auto check = [](double value, const char* what) {
+    if (!std::isfinite(value) || value <= 0.0)
+      throw InvalidInputError("rest scale", std::string(what) + " is not finite and positive");
+  };
+  switch (mode) {
+    case RestScale::Boundary:
+      check(sizes.source_boundary_length, "source boundary length");
+      check(sizes.target_boundary_length, "target boundary length");
+      return sizes.target_boundary_length / sizes.source_boundary_length;
+    case RestScale::Area:
+      check(sizes.source_area, "source area");
+      check(sizes.target_area, "target area");
+      // Lengths scale with the square root of areas.
+      return std::sqrt(sizes.target_area / sizes.source_area);
+    case RestScale::None:
+      return 1.0;
+  }
+  return 1.0;
+}
+
+SpringSystem::SpringSystem(const ParticleGrid& grid, const SpringEnergyOptions& options)
+    : grid_(&grid), options_(options), num_particles_(static_cast<int>(grid.mesh.n_vertices())) {
+  const std::string name = "particle grid";
+  if (!finite_non_negative(options.stiffness) || !finite_non_negative(options.angular_stiffness))
+    throw InvalidInputError(name, "spring stiffness must be finite and non-negative");
+  if (!std::isfinite(options.rest_scale) || options.rest_scale <= 0.0)
+    throw InvalidInputError(name, "rest scale must be finite and positive");
+  if (grid.springs.empty() && num_particles_ > 1)
+    throw InvalidInputError(name, "springs are not built (call build_springs())");
+
+  const int n = num_particles_;
+  const auto in_range = [n](int index) { return index >= 0 && index < n; };
+
+  std::vector<std::pair<int, int>> pairs;
+  pairs.reserve(2 * grid.springs.size());
+  for (std::size_t s = 0; s < grid.springs.size(); ++s) {
+    const Spring& spring = grid.springs[s];
+    if (!in_range(spring.i) || !in_range(spring.j) || spring.i == spring.j)
+      throw InvalidInputError(name,
+                              "spring " + std::to_string(s) + " has invalid particle indices");
+    if (!finite_non_negative(spring.rest))
+      throw InvalidInputError(name, "spring " + std::to_string(s) + " has an invalid rest length");
+    const int code = 2 * static_cast<int>(s);
+    pairs.emplace_back(spring.i, code + 1);
+    pairs.emplace_back(spring.j, code);
+  }
+  build_incidence(n, pairs, spring_offset_, spring_entry_);
+
+  pairs.clear();
+  pairs.reserve(3 * grid.angular_springs.size());
+  for (std::size_t c = 0; c < grid.angular_springs.size(); ++c) {
+    const AngularSpring& spring = grid.angular_springs[c];
+    if (!in_range(spring.i) || !in_range(spring.a) || !in_range(spring.b) || spring.a == spring.i ||
+        spring.b == spring.i || spring.a == spring.b)
+      throw InvalidInputError(
+          name, "angular spring " + std::to_string(c) + " has invalid particle indices");
+    if (!finite_non_negative(spring.rest))
+      throw InvalidInputError(
+          name, "angular spring " + std::to_string(c) + " has an invalid rest length");
+    const int code = 2 * static_cast<int>(c);
+    pairs.emplace_back(spring.i, code);
+    pairs.emplace_back(spring.a, code + 1);
+    pairs.emplace_back(spring.b, code + 1);
+  }
+  build_incidence(n, pairs, angular_offset_, angular_entry_);
+
+  // Face corners in the faces' stored (counter-clockwise) order, walking the halfedges.
+  corners_.reserve(4 * grid.mesh.n_faces());
+  std::vector<int> face;
+  for (const auto fh : grid.mesh.faces()) {
+    face.clear();
+    const auto first = grid.mesh.halfedge_handle(fh);
+    auto heh = first;
+    do {
+      face.push_back(grid.mesh.to_vertex_handle(heh).idx());
+      heh = grid.mesh.next_halfedge_handle(heh);
+    } while (heh != first);
+    const std::size_t k = face.size();
+    for (std::size_t c = 0; c < k; ++c)
+      corners_.push_back({face[c], face[(c + 1) % k], face[(c + k - 1) % k], fh.idx()});
+  }
+
+  spring_force_.resize(3, static_cast<Eigen::Index>(grid.springs.size()));
+  angular_force_.resize(3, static_cast<Eigen::Index>(grid.angular_springs.size()));
+}
+
+SpringEnergies SpringSystem::evaluate(const Eigen::Matrix3Xd& x, Eigen::Matrix3Xd* gradient) const {
+  if (x.cols() != num_particles_)
+    throw InvalidInputError("particle positions", "expected " + std::to_string(num_particles_) +
+                                                      " columns, got " + std::to_string(x.cols()));
+  const std::vector<Spring>& springs = grid_->springs;
+  const std::vector<AngularSpring>& angular = grid_->angular_springs;
+  const double C = options_.stiffness;
+  const double Ca = options_.angular_stiffness;
+  const double sigma = options_.rest_scale;
+  const bool want_gradient = gradient != nullptr;
+
+  // Normal springs, eq. 13: E = C (|d| - sigma k)^2, dE/dx_j = 2C (|d| - sigma k) d/|d| (eq. 14 up
+  // to the factor 2, see the header).
+  SpringEnergies energies;
+  energies.length = tbb::parallel_deterministic_reduce(
+      tbb::blocked_range<std::size_t>(0, springs.size(), kGrain), 0.0,
+      [&](const tbb::blocked_range<std::size_t>& range, double sum) {
+        for (std::size_t s = range.begin(); s != range.end(); ++s) {
+          const Spring& spring = springs[s];
+          const Eigen::Vector3d d = x.col(spring.j) - x.col(spring.i);
+          const double length = d.norm();
+          const double stretch = length - sigma * spring.rest;
+          sum += C * stretch * stretch;
+          if (want_gradient) {
+            const auto col = static_cast<Eigen::Index>(s);
+            if (length > 0.0)
+              spring_force_.col(col) = (2.0 * C * stretch / length) * d;
+            else
+              spring_force_.col(col).setZero();  // cone point: no gradient (see header)
+          }
+        }
+        return sum;
+      },
+      std::plus<double>());
+
+  // Angular springs: E = C_a (|e| - sigma r)^2 with e = x_i - (x_a + x_b)/2; dE/dx_i = 2 C_a (|e| -
+  // sigma r) e/|e|, and de/dx_a = de/dx_b = -I/2 gives the half-magnitude reactions.
+  energies.angular = tbb::parallel_deterministic_reduce(
+      tbb::blocked_range<std::size_t>(0, angular.size(), kGrain), 0.0,
+      [&](const tbb::blocked_range<std::size_t>& range, double sum) {
+        for (std::size_t c = range.begin(); c != range.end(); ++c) {
+          const AngularSpring& spring = angular[c];
+          const Eigen::Vector3d e = x.col(spring.i) - 0.5 * (x.col(spring.a) + x.col(spring.b));
+          const double length = e.norm();
+          const double stretch = length - sigma * spring.rest;
+          sum += Ca * stretch * stretch;
+          if (want_gradient) {
+            const auto col = static_cast<Eigen::Index>(c);
+            if (length > 0.0)
+              angular_force_.col(col) = (2.0 * Ca * stretch / length) * e;
+            else
+              angular_force_.col(col).setZero();
+          }
+        }
+        return sum;
+      },
+      std::plus<double>());
+
+  if (want_gradient) {
+    // Gather per particle in the fixed incidence order: no races, same bits for any thread count.
+    gradient->resize(3, num_particles_);
+    tbb::parallel_for(tbb::blocked_range<int>(0, num_particles_, static_cast<int>(kGrain)),
+                      [&](const tbb::blocked_range<int>& range) {
+                        for (int p = range.begin(); p != range.end(); ++p) {
+                          Eigen::Vector3d g = Eigen::Vector3d::Zero();
+                          for (int k = spring_offset_[p]; k < spring_offset_[p + 1]; ++k) {
+                            const int code = spring_entry_[k];
+                            if (code & 1)
+                              g -= spring_force_.col(code >> 1);
+                            else
+                              g += spring_force_.col(code >> 1);
+                          }
+                          for (int k = angular_offset_[p]; k < angular_offset_[p + 1]; ++k) {
+                            const int code = angular_entry_[k];
+                            if (code & 1)
+                              g -= 0.5 * angular_force_.col(code >> 1);
+                            else
+                              g += angular_force_.col(code >> 1);
+                          }
+                          gradient->col(p) = g;
+                        }
+                      });
+  }
+  return energies;
+}
+
+void SpringSystem::folded_corners(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& normals,
+                                  std::vector<char>& folded) const {
+  folded.resize(corners_.size());
+  tbb::parallel_for(
+      tbb::blocked_range<std::size_t>(0, corners_.size(), kGrain),
+      [&](const tbb::blocked_range<std::size_t>& range) {
+        for (std::size_t c = range.begin(); c != range.end(); ++c) {
+          const Corner& corner = corners_[c];
+          const Eigen::Vector3d xi = x.col(corner.i);
+          const double orientation =
+              (x.col(corner.next) - xi).cross(x.col(corner.prev) - xi).dot(normals.col(corner.i));
+          // "<= 0" also flags degenerate (collapsed) corners; NaN counts as folded.
+          folded[c] = !(orientation > 0.0);
+        }
+      });
+}
+
+int SpringSystem::folded_faces(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& normals) const {
+  std::vector<char> folded;
+  folded_corners(x, normals, folded);
+  int count = 0;
+  int last_face = -1;
+  for (std::size_t c = 0; c < corners_.size(); ++c) {
+    // Corners of one face are consecutive; count each face once.
+    if (folded[c] && corners_[c].face != last_face) {
+      ++count;
+      last_face = corners_[c].face;
+    }
+  }
+  return count;
+}
+
+SpringEnergies spring_energy(const ParticleGrid& grid, const Eigen::Matrix3Xd& x,
+                             const SpringEnergyOptions& options, Eigen::Matrix3Xd* gradient) {
+  return SpringSystem(grid, options).evaluate(x, gradient);
+}
+
+double magnet_energy(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& closest, double stiffness,
+                     const std::vector<char>& active, Eigen::Matrix3Xd* gradient) {
+  if (closest.cols() != x.cols() || (!active.empty() && active.size() != std::size_t(x.cols())) ||
+      (gradient != nullptr && gradient->cols() != x.cols()))
+    throw InvalidInputError("magnet", "positions, closest points and gradient differ in size");
+  double energy = 0.0;
+  for (Eigen::Index p = 0; p < x.cols(); ++p) {
+    if (!active.empty() && !active[static_cast<std::size_t>(p)]) continue;
+    const Eigen::Vector3d offset = x.col(p) - closest.col(p);
+    energy += 0.5 * stiffness * offset.squaredNorm();
+    if (gradient != nullptr) gradient->col(p) += stiffness * offset;
+  }
+  return energy;
+}
+
+}  // namespace elastic

@@ -1,0 +1,138 @@
+#pragma once
+/// \file
+/// The energies of the particle system on the target surface (paper §4.2, §4.4 and the Appendix)
+/// and their exact gradients, plus the rest-scale factor and the fold test the solvers use.
+///
+/// With x_i the 3D target position of particle i (3 x #P matrix `x`), sigma the rest scale:
+///
+/// - normal springs (eq. 13, Appendix):  E_len = C * sum_{springs (i,j)} (|x_j - x_i| - sigma
+/// k_ij)^2
+///   gradient on j: 2C (|d| - sigma k) d/|d| with d = x_j - x_i, and its negative on i. The paper's
+///   eq. 14 writes this force as C d/|d| (|d| - k): its C is our 2C (eq. 13 sums every spring
+///   twice, once from each end, we sum it once).
+/// - angular springs (§4.1, Fig. 1): E_ang = C_a * sum_{corners (i; a, b)} (|x_i - (x_a + x_b)/2| -
+/// sigma r_i)^2
+///   gradient on i: g = 2C_a (|e| - sigma r) e/|e| with e = x_i - (x_a + x_b)/2; on a and on b
+///   exactly -g/2 (the virtual midpoint moves by half of what a or b moves). These are the paper's
+///   "opposite force with half the magnitude" on the two neighbours, and the three sum to zero: the
+///   springs conserve momentum.
+/// - magnet (§4.4, Appendix): E_mag = c/2 * sum_i |x_i - x'_i|^2 with x'_i the closest point of the
+/// surface.
+///   Half the squared distance to a smooth surface has gradient x - x' (the closest point moves,
+///   but only along the surface, orthogonally to x - x': envelope theorem), so the gradient is c (x
+///   - x'), the paper's f^m = c (x' - x) as a force. The paper writes the energy without the 1/2;
+///   we keep the force.
+///
+/// Degenerate springs: at |d| = 0 (or |e| = 0) the energy has a cone point and no gradient; that
+/// spring then contributes zero to the gradient (a valid subgradient choice that keeps the sum of
+/// forces zero).
+///
+/// Threads and determinism: the gradient is computed per spring into a buffer (in parallel), then
+/// gathered per particle in a fixed order (in parallel); energies are summed with a deterministic
+/// reduction. The result is bit-identical for the same input whatever the number of threads.
+
+#include <Eigen/Core>
+#include <string_view>
+#include <vector>
+
+#include "elastic/particles/particle_grid.h"
+
+namespace elastic {
+
+/// How the rest lengths are scaled when the source and target regions differ in size.
+enum class RestScale {
+  Boundary,  ///< sigma = target boundary length / source boundary length (the default)
+  Area,      ///< sigma = sqrt(target area / source area)
+  None       ///< sigma = 1: absolute sizes are kept
+};
+
+/// "boundary", "area", "none".
+std::string_view to_string(RestScale mode);
+/// Parses "boundary", "area", "none". \throws InvalidInputError naming `input` otherwise.
+RestScale parse_rest_scale(std::string_view text, std::string_view input = "rest scale");
+
+/// Sizes of the two regions that the rest-scale factor compares.
+struct RegionSizes {
+  double source_boundary_length = 1.0;  ///< length of the source boundary curve
+  double target_boundary_length = 1.0;  ///< length of the target boundary curve
+  double source_area = 1.0;             ///< area of the source region
+  double target_area = 1.0;             ///< area of the target region
+};
+
+/// The factor sigma of the chosen mode (see RestScale).
+/// \throws InvalidInputError when a size the mode uses is not finite and positive.
+double rest_scale_factor(RestScale mode, const RegionSizes& sizes);
+
+struct SpringEnergyOptions {
+  double stiffness = 1.0;          ///< C, normal springs (eq. 13)
+  double angular_stiffness = 1.0;  ///< C_a, angular springs
+  double rest_scale = 1.0;         ///< sigma, multiplies every rest value
+};
+
+/// Energies per term.
+struct SpringEnergies {
+  double length = 0.0;   ///< E_len (eq. 13)
+  double angular = 0.0;  ///< E_ang
+  double total() const { return length + angular; }
+};
+
+/// The spring energies of one ParticleGrid, with the incidence tables precomputed for fast,
+/// deterministic evaluation. The grid must outlive the object and its springs must be built.
+/// `evaluate` uses internal scratch buffers: one SpringSystem must not evaluate from two threads at
+/// once (it parallelises itself).
+class SpringSystem {
+ public:
+  /// \throws InvalidInputError when the grid has no springs or a spring index is out of range, or
+  /// the
+  ///         options are not finite and non-negative (rest_scale positive).
+  SpringSystem(const ParticleGrid& grid, const SpringEnergyOptions& options = {});
+
+  int num_particles() const { return num_particles_; }
+  const SpringEnergyOptions& options() const { return options_; }
+
+  /// Energies at positions `x` (3 x #P); when `gradient` is given it receives dE/dx (3 x #P,
+  /// resized).
+  SpringEnergies evaluate(const Eigen::Matrix3Xd& x, Eigen::Matrix3Xd* gradient = nullptr) const;
+
+  /// Number of grid faces with at least one folded corner at positions `x`, given unit surface
+  /// normals `normals` (3 x #P) at the particles. A corner (prev, i, next) of a counter-clockwise
+  /// face is folded when ((x_next - x_i) x (x_prev - x_i)) . n_i <= 0.
+  int folded_faces(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& normals) const;
+  /// Per corner (in the order of `corners()`), whether it is folded.
+  void folded_corners(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& normals,
+                      std::vector<char>& folded) const;
+
+  /// A face corner for the fold test: particle i and its successor and predecessor in the face.
+  struct Corner {
+    int i = -1;
+    int next = -1;
+    int prev = -1;
+    int face = -1;
+  };
+  const std::vector<Corner>& corners() const { return corners_; }
+
+ private:
+  const ParticleGrid* grid_ = nullptr;
+  SpringEnergyOptions options_;
+  int num_particles_ = 0;
+  // Incidence in compressed rows: for particle p, entries [offset[p], offset[p+1]) encode 2*index +
+  // side (side 0: p is the spring's j / the corner's i, side 1: p is i / one of a, b).
+  std::vector<int> spring_offset_, spring_entry_;
+  std::vector<int> angular_offset_, angular_entry_;
+  std::vector<Corner> corners_;
+  mutable Eigen::Matrix3Xd spring_force_;   // per spring: dE/dx_j
+  mutable Eigen::Matrix3Xd angular_force_;  // per angular spring: dE/dx_i
+};
+
+/// Convenience: builds a SpringSystem and evaluates it once.
+SpringEnergies spring_energy(const ParticleGrid& grid, const Eigen::Matrix3Xd& x,
+                             const SpringEnergyOptions& options = {},
+                             Eigen::Matrix3Xd* gradient = nullptr);
+
+/// The magnet energy (§4.4) c/2 * sum_i |x_i - x'_i|^2 over the particles with `active[i]` != 0
+/// (all when `active` is empty), x' the closest surface points (3 x #P). When `gradient` is given,
+/// c (x - x') is *added* to it for the active particles (it must be 3 x #P).
+double magnet_energy(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& closest, double stiffness,
+                     const std::vector<char>& active = {}, Eigen::Matrix3Xd* gradient = nullptr);
+
+}  // namespace elastic

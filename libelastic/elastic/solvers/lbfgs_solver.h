@@ -1,0 +1,41 @@
+#pragma once
+/// \file
+/// Fast mode of `relax` (relaxation.h): a tangent-space quasi-Newton solver for min E_len + E_ang
+/// over the interior particles constrained to the target limit surface. Not in the paper; it
+/// reaches the equilibrium the paper's integrator (eqs. 9-12) converges to, in far fewer
+/// evaluations.
+///
+/// Per iteration, with g the spring gradient (3 x #P) and P the projection on the tangent planes at
+/// the interior particles (boundary rows are zero: those particles are fixed):
+/// 1. Tangential gradient q = P g (the force the magnet leaves once particles sit on the surface).
+/// 2. Direction p = -H q by the L-BFGS two-loop recursion over the last `memory` pairs (s, y) (s:
+/// change of
+///    the positions, y: change of P g), with the initial inverse Hessian H0 = L^-1, L the interior
+///    spring Laplacian (solver_common.h: 2C per spring plus the angular springs' Gram matrices),
+///    factorised once with a sparse LDL^T and applied to the x, y and z coordinates. The first step
+///    is therefore the Laplacian solve -L^-1 P g, a Newton step for the springs linearised at rest.
+/// 3. p is projected on the tangent planes again. If it is not a descent direction (P g . p >= 0)
+/// the
+///    memory is cleared and p = -P L^-1 P g is used.
+/// 4. Retraction: x_i(alpha) = closest point on the surface to x_i + alpha p_i (the magnet of §4.4,
+/// warm
+///    started from the particle's current surface point).
+/// 5. Backtracking line search from alpha = 1: a trial is rejected when it folds a face corner that
+/// was not
+///    folded (SpringSystem::folded_corners with the new normals), when the energy is not finite, or
+///    when the Armijo condition E(alpha) <= E + c1 alpha (P g . p) fails. Close to the minimum the
+///    energy change can drop below its round-off; a trial whose energy is within 1e-13 E of the
+///    current one is then accepted when its tangential gradient is smaller.
+/// 6. The pair (s, y) is kept when s . y > 1e-12 |s| |y| (curvature condition).
+/// Stopping: see relaxation.h (tangential gradient only). When no trial is accepted with an empty
+/// memory, the solver stops with StopReason::LineSearchFailed.
+
+#include "elastic/solvers/relaxation.h"
+
+namespace elastic {
+
+/// Runs the L-BFGS solver (use `relax` with SolverKind::Fast; this is what it calls, in the
+/// caller's arena). \throws as relax.
+RelaxationResult relax_lbfgs(const RelaxationProblem& problem, const RelaxationOptions& options);
+
+}  // namespace elastic

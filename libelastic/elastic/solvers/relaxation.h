@@ -1,0 +1,163 @@
+#pragma once
+/// \file
+/// Least-distortion relaxation of a particle grid on the target surface (paper §4.2, §4.4-4.6): the
+/// interior particles move on the target limit surface to a minimum of the spring energy E_len +
+/// E_ang (particles/spring_energy.h) while the boundary particles stay where the boundary
+/// correspondence put them.
+///
+/// Two solvers, one result (see docs/solvers.md):
+/// - `SolverKind::Fast` (default): tangent-space L-BFGS preconditioned with the prefactored spring
+/// Laplacian,
+///   the magnet (closest point) as the retraction, fold-rejecting Armijo line search
+///   (lbfgs_solver.h).
+/// - `SolverKind::Faithful`: the paper's damped explicit integrator, eqs. 9-12
+/// (explicit_integrator.h).
+///
+/// Both stop when the tangential gradient |P g| (the spring gradient projected on the target's
+/// tangent planes at the interior particles) falls below `relative_gradient_tolerance` times its
+/// initial value, or below the scale-free absolute bound `absolute_gradient_tolerance * C_max *
+/// sigma * mean_rest * sqrt(#P)`; never on an energy change alone.
+///
+/// Threads: the solvers run in a TBB arena of `threads` threads (0: all). Same inputs give
+/// bit-identical results run to run; the energy and gradient are identical for any thread count
+/// (the projector's batched query is as well, being one independent query per particle).
+
+#include <Eigen/Core>
+#include <functional>
+#include <string_view>
+#include <vector>
+
+#include "elastic/core/progress.h"
+#include "elastic/particles/particle_grid.h"
+#include "elastic/particles/spring_energy.h"
+#include "elastic/projection/closest_point.h"
+#include "elastic/surface/surface_point.h"
+
+namespace elastic {
+
+enum class SolverKind {
+  Fast,     ///< tangent-space L-BFGS (default)
+  Faithful  ///< the paper's explicit integrator (eqs. 9-12)
+};
+/// "fast", "faithful".
+std::string_view to_string(SolverKind kind);
+/// Parses "fast" or "faithful". \throws InvalidInputError naming `input` otherwise.
+SolverKind parse_solver_kind(std::string_view text, std::string_view input = "solver");
+
+/// Why a solver stopped.
+enum class StopReason {
+  RelativeGradient,  ///< converged: |P g| <= relative tolerance * initial |P g|
+  AbsoluteGradient,  ///< converged: |P g| below the scale-free absolute bound
+  NoFreeParticles,   ///< converged trivially: every particle is on the boundary
+  MaxIterations,     ///< not converged: the iteration budget ran out
+  LineSearchFailed,  ///< not converged: no fold-free step decreases the energy (L-BFGS)
+  Diverged,          ///< not converged: the energy or a position became non-finite (explicit)
+  Cancelled          ///< not converged: the progress callback asked to stop
+};
+/// A short lower-case description, e.g. "relative tangential gradient below tolerance".
+std::string_view to_string(StopReason reason);
+/// True for the reasons that mean convergence.
+inline bool is_converged(StopReason reason) {
+  return reason == StopReason::RelativeGradient || reason == StopReason::AbsoluteGradient ||
+         reason == StopReason::NoFreeParticles;
+}
+
+/// One configuration handed to the frame callback.
+struct RelaxationFrame {
+  long iteration = 0;                           ///< iteration (L-BFGS) or time step (explicit)
+  const Eigen::Matrix3Xd* positions = nullptr;  ///< 3 x #P current positions
+  double energy = 0.0;                          ///< current E_len + E_ang
+  double relative_gradient = 0.0;               ///< current |P g| / initial |P g|
+};
+/// Receives every `frame_interval`-th configuration (e.g. to write an animation).
+using FrameCallback = std::function<void(const RelaxationFrame&)>;
+
+/// Options of the explicit integrator (eqs. 9-12). Zero means "choose a stable default" (documented
+/// in explicit_integrator.h).
+struct ExplicitOptions {
+  double mass = 1.0;              ///< m_i, the same for every particle (eq. 9)
+  double damping = 0.0;           ///< gamma_i (eq. 9); 0: critical damping of the slowest mode
+  double time_step = 0.0;         ///< dt (eqs. 11-12); 0: stability_factor * 2 sqrt(m / lambda_max)
+  double stability_factor = 0.5;  ///< fraction of the stability limit used when time_step is 0
+  double magnet_stiffness = 0.0;  ///< c of the magnet (§4.4); 0: the largest particle stiffness
+  double drift_tolerance = 1e-3;  ///< re-project exactly when a particle is farther than this times
+                                  ///< the mean rest length from the surface
+};
+
+/// Options of the L-BFGS solver.
+struct LbfgsOptions {
+  int memory = 8;           ///< number of (s, y) pairs kept
+  double armijo = 1e-4;     ///< sufficient-decrease constant c1 of the Armijo condition
+  int max_backtracks = 40;  ///< step halvings per line search before giving up
+};
+
+struct RelaxationOptions {
+  SolverKind solver = SolverKind::Fast;  ///< which solver
+  double stiffness = 1.0;                ///< C of the normal springs (eq. 13)
+  double angular_stiffness = 1.0;        ///< C_a of the angular springs
+  /// Iteration (L-BFGS) or time-step (explicit) budget; 0: 2,000 for L-BFGS, 200,000 for explicit.
+  long max_iterations = 0;
+  double relative_gradient_tolerance = 1e-6;  ///< stop when |P g| <= this * initial |P g|
+  double absolute_gradient_tolerance =
+      1e-10;                            ///< ... or |P g| <= this * C_max sigma mean_rest sqrt(#P)
+  int threads = 0;                      ///< TBB threads; 0: all available
+  ProgressCallback progress;            ///< called every iteration (L-BFGS) / check (explicit)
+  FrameCallback frame;                  ///< called every `frame_interval` iterations
+  long frame_interval = 1;              ///< k of "every k-th configuration", >= 1
+  ExplicitOptions explicit_integrator;  ///< faithful-mode parameters
+  LbfgsOptions lbfgs;                   ///< fast-mode parameters
+};
+
+/// The input: a particle grid, the target surface, and the starting placement on it.
+struct RelaxationProblem {
+  const ParticleGrid* grid = nullptr;        ///< springs built; must outlive the call
+  const SurfaceProjector* target = nullptr;  ///< the target limit surface's magnet
+  Eigen::Matrix3Xd initial_positions;        ///< 3 x #P start positions on the target surface
+  std::vector<SurfacePoint> initial_points;  ///< #P their surface points
+  double rest_scale = 1.0;                   ///< sigma (rest_scale_factor)
+  RestScale rest_scale_mode = RestScale::Boundary;  ///< how sigma was chosen (echoed in the result)
+  /// 3 x boundary_loop.size(): where each boundary particle belongs on the target curve (its
+  /// arc-length position). Optional: when empty, the boundary residual is measured against
+  /// initial_positions.
+  Eigen::Matrix3Xd boundary_targets;
+};
+
+struct RelaxationResult {
+  Eigen::Matrix3Xd positions;        ///< 3 x #P final positions, on the target surface
+  std::vector<SurfacePoint> points;  ///< #P final surface points
+  SolverKind solver = SolverKind::Fast;
+  long iterations = 0;   ///< L-BFGS iterations or explicit time steps
+  long evaluations = 0;  ///< energy evaluations (L-BFGS line-search trials included)
+  bool converged = false;
+  StopReason reason = StopReason::MaxIterations;
+  double setup_seconds = 0.0;   ///< incidence tables, Laplacian factorisation, normals
+  double solve_seconds = 0.0;   ///< the iterations
+  double initial_energy = 0.0;  ///< E_len + E_ang at the start
+  double length_energy = 0.0;   ///< final E_len (eq. 13)
+  double angular_energy = 0.0;  ///< final E_ang
+  double magnet_energy = 0.0;   ///< explicit: magnet energy of the last integrator state before the
+                                ///< final projection; L-BFGS: 0 (particles stay on the surface)
+  double gradient_norm = 0.0;   ///< final |P g|
+  double initial_gradient_norm = 0.0;  ///< initial |P g|
+  double relative_gradient =
+      0.0;                       ///< gradient_norm / initial_gradient_norm (0 when the latter is 0)
+  int folded_faces = 0;          ///< faces with a folded corner at the end
+  int initial_folded_faces = 0;  ///< the same at the start
+  double boundary_residual = 0.0;  ///< max distance of a boundary particle from its target position
+  double rest_scale = 1.0;         ///< sigma used
+  RestScale rest_scale_mode = RestScale::Boundary;  ///< its mode, as given
+  // Explicit integrator parameters actually used (0 for L-BFGS).
+  double time_step = 0.0;         ///< dt
+  double damping = 0.0;           ///< gamma
+  double magnet_stiffness = 0.0;  ///< c
+  long reprojections = 0;         ///< explicit: steps that re-projected drifting particles
+};
+
+/// Relaxes the interior particles of `problem` on the target surface.
+/// \throws InvalidInputError when the problem is inconsistent (sizes, missing grid or target,
+/// non-finite
+///         positions, invalid options); NumericalError when the spring Laplacian cannot be
+///         factorised (an interior component not connected to the boundary).
+RelaxationResult relax(const RelaxationProblem& problem, const RelaxationOptions& options = {});
+
+}  // namespace elastic
