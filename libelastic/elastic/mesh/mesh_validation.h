@@ -75,7 +75,7 @@ struct MeshValidation {
   IndexFindings malformed_faces;        ///< faces with < 3 corners or a vertex index out of range
   IndexFindings non_finite_vertices;    ///< vertices with a NaN or infinite coordinate
   IndexFindings repeated_index_faces;   ///< faces listing a vertex more than once
-  IndexFindings zero_area_faces;        ///< faces whose area is zero (see ValidationOptions)
+  IndexFindings zero_area_faces;        ///< other faces whose area is zero (see ValidationOptions)
   EdgeFindings non_manifold_edges;      ///< edges used by more than two faces
   EdgeFindings inconsistent_edges;      ///< edges used twice in the same direction
   IndexFindings non_manifold_vertices;  ///< vertices whose faces do not form one fan

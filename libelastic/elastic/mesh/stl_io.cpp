@@ -2,6 +2,7 @@
 // coordinates (after turning -0 into +0) into shared vertices, in order of first appearance.
 // Nothing closer than identical is merged: welding by distance would be a guess.
 
+#include <Eigen/Geometry>
 #include <bit>
 #include <cstdint>
 #include <cstring>
