@@ -1,0 +1,189 @@
+// Energies of particles/spring_energy.h against finite differences, conservation laws and hand
+// values.
+
+#include "elastic/particles/spring_energy.h"
+
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "elastic/core/error.h"
+#include "solvers/solver_fixtures.h"
+
+namespace elastic {
+namespace {
+
+// A 4 x 3-cell grid whose particles are moved randomly in 3D by up to `amplitude` (spacing 1):
+// generic stretched, compressed and sheared springs.
+Eigen::Matrix3Xd random_configuration(const ParticleGrid& grid, double amplitude, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> jitter(-amplitude, amplitude);
+  Eigen::Matrix3Xd x = test::grid_positions(grid);
+  for (Eigen::Index p = 0; p < x.cols(); ++p)
+    for (int c = 0; c < 3; ++c) x(c, p) += jitter(rng);
+  return x;
+}
+
+// Central differences of `energy` at x, step h per coordinate.
+template <typename Energy>
+Eigen::Matrix3Xd central_differences(const Eigen::Matrix3Xd& x, double h, Energy energy) {
+  Eigen::Matrix3Xd g(3, x.cols());
+  for (Eigen::Index p = 0; p < x.cols(); ++p)
+    for (int c = 0; c < 3; ++c) {
+      Eigen::Matrix3Xd plus = x, minus = x;
+      plus(c, p) += h;
+      minus(c, p) -= h;
+      g(c, p) = (energy(plus) - energy(minus)) / (2.0 * h);
+    }
+  return g;
+}
+
+// Central differences have truncation error h^2 |E'''| / 6 and round-off eps |E| / h; with h = 1e-5
+// on a configuration of unit size both are below 1e-9 relative, far under the 1e-6 required.
+constexpr double kStep = 1e-5;
+constexpr double kRelative = 1e-6;
+
+TEST(SpringEnergy, LengthGradientMatchesFiniteDifferences) {
+  const ParticleGrid grid = test::make_quad_grid(4, 3, 1.0);
+  const SpringEnergyOptions options{.stiffness = 1.7, .angular_stiffness = 0.0, .rest_scale = 1.3};
+  const SpringSystem system(grid, options);
+  for (unsigned seed = 1; seed <= 3; ++seed) {
+    const Eigen::Matrix3Xd x = random_configuration(grid, 0.4, seed);
+    Eigen::Matrix3Xd gradient;
+    const SpringEnergies e = system.evaluate(x, &gradient);
+    EXPECT_EQ(e.angular, 0.0);
+    EXPECT_GT(e.length, 0.0);
+    const Eigen::Matrix3Xd fd = central_differences(
+        x, kStep, [&](const Eigen::Matrix3Xd& y) { return system.evaluate(y).total(); });
+    EXPECT_LT((fd - gradient).norm(), kRelative * gradient.norm()) << "seed " << seed;
+  }
+}
+
+TEST(SpringEnergy, AngularGradientMatchesFiniteDifferences) {
+  const ParticleGrid grid = test::make_quad_grid(4, 3, 1.0);
+  const SpringEnergyOptions options{.stiffness = 0.0, .angular_stiffness = 2.3, .rest_scale = 0.8};
+  const SpringSystem system(grid, options);
+  for (unsigned seed = 1; seed <= 3; ++seed) {
+    const Eigen::Matrix3Xd x = random_configuration(grid, 0.4, seed);
+    Eigen::Matrix3Xd gradient;
+    const SpringEnergies e = system.evaluate(x, &gradient);
+    EXPECT_EQ(e.length, 0.0);
+    EXPECT_GT(e.angular, 0.0);
+    const Eigen::Matrix3Xd fd = central_differences(
+        x, kStep, [&](const Eigen::Matrix3Xd& y) { return system.evaluate(y).total(); });
+    EXPECT_LT((fd - gradient).norm(), kRelative * gradient.norm()) << "seed " << seed;
+  }
+}
+
+TEST(SpringEnergy, ForcesConserveLinearAndAngularMomentum) {
+  // Internal forces of a translation- and rotation-invariant energy sum to zero and have zero total
+  // torque.
+  const ParticleGrid grid = test::make_quad_grid(5, 4, 1.0);
+  const SpringSystem system(grid, {.stiffness = 1.0, .angular_stiffness = 3.0, .rest_scale = 1.1});
+  const Eigen::Matrix3Xd x = random_configuration(grid, 0.45, 7);
+  Eigen::Matrix3Xd gradient;
+  system.evaluate(x, &gradient);
+  Eigen::Vector3d torque = Eigen::Vector3d::Zero();
+  for (Eigen::Index p = 0; p < x.cols(); ++p)
+    torque += Eigen::Vector3d(x.col(p)).cross(Eigen::Vector3d(gradient.col(p)));
+  // Round-off of sums of O(1) terms.
+  EXPECT_LT(gradient.rowwise().sum().norm(), 1e-12 * gradient.norm());
+  EXPECT_LT(torque.norm(), 1e-12 * gradient.norm() * x.norm());
+
+  // Each angular spring alone: the reactions on a and b are exactly half of the force on i,
+  // opposite.
+  for (const AngularSpring& s : grid.angular_springs) {
+    ParticleGrid single = grid;
+    single.springs = {grid.springs.front()};
+    single.angular_springs = {s};
+    Eigen::Matrix3Xd g;
+    SpringSystem(single, {.stiffness = 0.0, .angular_stiffness = 1.0}).evaluate(x, &g);
+    EXPECT_EQ(g.col(s.a), -0.5 * g.col(s.i));
+    EXPECT_EQ(g.col(s.b), -0.5 * g.col(s.i));
+  }
+}
+
+TEST(SpringEnergy, HandValuesAndRestScale) {
+  // One cell of side 1, stretched along x by 2: the two x springs have length 2, rest 1 (sigma 1).
+  const ParticleGrid grid = test::make_quad_grid(1, 1, 1.0);
+  Eigen::Matrix3Xd x = test::grid_positions(grid);
+  x.row(0) *= 2.0;
+  const SpringEnergies e =
+      SpringSystem(grid, {.stiffness = 3.0, .angular_stiffness = 0.0}).evaluate(x);
+  EXPECT_DOUBLE_EQ(e.length, 3.0 * 2.0 * 1.0);  // C * 2 springs * (2 - 1)^2
+  // With sigma = 2 the stretched x springs are at rest and the y springs (length 1) are compressed
+  // by 1.
+  const SpringEnergies scaled =
+      SpringSystem(grid, {.stiffness = 3.0, .angular_stiffness = 0.0, .rest_scale = 2.0})
+          .evaluate(x);
+  EXPECT_DOUBLE_EQ(scaled.length, 3.0 * 2.0 * 1.0);
+  // A uniformly scaled grid is at rest with sigma equal to the scale.
+  const Eigen::Matrix3Xd big = 2.5 * test::grid_positions(grid);
+  const SpringEnergies rest =
+      SpringSystem(grid, {.stiffness = 1.0, .angular_stiffness = 1.0, .rest_scale = 2.5})
+          .evaluate(big);
+  EXPECT_LT(rest.total(), 1e-28);
+
+  EXPECT_DOUBLE_EQ(rest_scale_factor(RestScale::Boundary, {.source_boundary_length = 2.0,
+                                                           .target_boundary_length = 3.0}),
+                   1.5);
+  EXPECT_DOUBLE_EQ(rest_scale_factor(RestScale::Area, {.source_area = 4.0, .target_area = 9.0}),
+                   1.5);
+  EXPECT_EQ(rest_scale_factor(RestScale::None, {.source_area = 4.0, .target_area = 9.0}), 1.0);
+  EXPECT_THROW(rest_scale_factor(RestScale::Area, {.source_area = 0.0}), InvalidInputError);
+  EXPECT_EQ(parse_rest_scale("area"), RestScale::Area);
+  EXPECT_EQ(to_string(parse_rest_scale("boundary")), "boundary");
+  EXPECT_THROW(parse_rest_scale("volume"), InvalidInputError);
+}
+
+TEST(SpringEnergy, MagnetGradientMatchesFiniteDifferences) {
+  // Unit sphere: the closest point is x / |x|, so E = c/2 (|x| - 1)^2 per particle; the gradient c
+  // (x - x') must match differences of that energy although x' moves with x (envelope theorem).
+  const double c = 2.5;
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> coordinate(-1.5, 1.5);
+  Eigen::Matrix3Xd x(3, 6);
+  for (Eigen::Index p = 0; p < x.cols(); ++p)
+    x.col(p) = Eigen::Vector3d(coordinate(rng), coordinate(rng), coordinate(rng));
+  const auto sphere_closest = [](const Eigen::Matrix3Xd& y) {
+    return Eigen::Matrix3Xd(y.colwise().normalized());
+  };
+  Eigen::Matrix3Xd gradient = Eigen::Matrix3Xd::Zero(3, x.cols());
+  const std::vector<char> active = {1, 1, 0, 1, 1, 1};
+  magnet_energy(x, sphere_closest(x), c, active, &gradient);
+  const Eigen::Matrix3Xd fd = central_differences(x, kStep, [&](const Eigen::Matrix3Xd& y) {
+    return magnet_energy(y, sphere_closest(y), c, active);
+  });
+  EXPECT_LT((fd - gradient).norm(), kRelative * gradient.norm());
+  EXPECT_EQ(gradient.col(2), Eigen::Vector3d::Zero());
+}
+
+TEST(SpringEnergy, FoldedFacesAreCounted) {
+  const ParticleGrid grid = test::make_quad_grid(3, 3, 1.0);
+  Eigen::Matrix3Xd x = test::grid_positions(grid);
+  const Eigen::Matrix3Xd up = Eigen::Vector3d::UnitZ().replicate(1, x.cols());
+  const SpringSystem system(grid);
+  EXPECT_EQ(system.folded_faces(x, up), 0);
+  EXPECT_EQ(system.folded_faces(x, -up), 9);  // seen from below every face is clockwise
+  // Push particle (1,1) (index 5) past its neighbour (2,1) to (2.5, 1). Of its four faces, the left
+  // two stay convex; in cell (1,0) the corner at (2,1) turns clockwise ((0.5,0) x (0,-1) has z =
+  // -0.5) and in cell (1,1) the corner at the moved particle does ((-0.5,0) x (-1.5,1) has z =
+  // -0.5): two folded faces.
+  x.col(5) = Eigen::Vector3d(2.5, 1.0, 0.0);
+  EXPECT_EQ(system.folded_faces(x, up), 2);
+}
+
+TEST(SpringEnergy, RejectsInvalidGrids) {
+  ParticleGrid grid = test::make_quad_grid(2, 2, 1.0);
+  grid.springs[0].j = 99;
+  EXPECT_THROW(SpringSystem{grid}, InvalidInputError);
+  grid = test::make_quad_grid(2, 2, 1.0);
+  grid.springs.clear();
+  EXPECT_THROW(SpringSystem{grid}, InvalidInputError);
+  grid = test::make_quad_grid(2, 2, 1.0);
+  EXPECT_THROW(SpringSystem(grid, {.rest_scale = 0.0}), InvalidInputError);
+  EXPECT_THROW(SpringSystem(grid).evaluate(Eigen::Matrix3Xd::Zero(3, 2)), InvalidInputError);
+}
+
+}  // namespace
+}  // namespace elastic
