@@ -47,9 +47,9 @@ TEST(ParticleGrid, NormalSpringsAreTheEdgesWithSourceLengths) {
   std::set<std::pair<int, int>> edges;
   for (const Spring& s : grid.springs) {
     edges.insert({std::min(s.i, s.j), std::max(s.i, s.j)});
-    // Hand-computed lengths: axis-aligned unit edges, and the triangle's slanted sides sqrt(2).
-    const bool slanted =
-        (std::min(s.i, s.j) == 3 || std::min(s.i, s.j) == 4) && std::max(s.i, s.j) == 6;
+    // Hand-computed lengths: unit edges, except the triangle's side 3-6 from (0,1) to (1,2),
+    // sqrt(2).
+    const bool slanted = std::min(s.i, s.j) == 3 && std::max(s.i, s.j) == 6;
     EXPECT_DOUBLE_EQ(s.rest, slanted ? std::sqrt(2.0) : 1.0) << s.i << "-" << s.j;
   }
   const std::set<std::pair<int, int>> expected = {{0, 1}, {1, 2}, {0, 3}, {1, 4}, {2, 5},

@@ -15,6 +15,7 @@
 namespace elastic {
 namespace {
 
+using test::disk_spec;
 using test::expect_valid_faces;
 using test::make_grid_region;
 using test::make_height_grid;
@@ -174,7 +175,8 @@ TEST(AdaptiveSampling, TexcoordsFollowMovedParticles) {
 TEST(AdaptiveSampling, SphereCapStaysValid) {
   const LimitSurface sphere(make_sphere(ShapeOptions{.faces = ShapeFaces::Quads, .resolution = 8}));
   const SurfaceProjector projector(sphere);
-  const Region cap = make_region(projector, parse_region_spec("disk:0,0,1,0.8"));
+  const Region cap =
+      make_region(projector, parse_region_spec(disk_spec(projector, {0, 0, 1}, 0.8)));
   SampleRegionOptions options;
   options.layout.particles = 600;
   options.sampling.max_iterations = 50;

@@ -17,6 +17,7 @@
 namespace elastic {
 namespace {
 
+using test::disk_spec;
 using test::expect_valid_faces;
 using test::make_grid_region;
 using test::make_height_grid;
@@ -206,7 +207,8 @@ TEST(GridLayout, FacesValidOnPlaneAndBump) {
 TEST(GridLayout, CountsAndFacesOnSphereCapAndTorus) {
   const LimitSurface sphere(make_sphere(ShapeOptions{.faces = ShapeFaces::Quads, .resolution = 8}));
   const SurfaceProjector sphere_projector(sphere);
-  const Region cap = make_region(sphere_projector, parse_region_spec("disk:0,0,1,0.8"));
+  const Region cap =
+      make_region(sphere_projector, parse_region_spec(disk_spec(sphere_projector, {0, 0, 1}, 0.8)));
   for (const long n : {100L, 1000L, 20000L}) {
     GridLayoutOptions options;
     options.particles = n;
@@ -216,7 +218,8 @@ TEST(GridLayout, CountsAndFacesOnSphereCapAndTorus) {
   }
   const LimitSurface torus(make_torus(ShapeOptions{.faces = ShapeFaces::Quads, .resolution = 16}));
   const SurfaceProjector torus_projector(torus);
-  const Region patch = make_region(torus_projector, parse_region_spec("disk:1.35,0,0,0.5"));
+  const Region patch = make_region(
+      torus_projector, parse_region_spec(disk_spec(torus_projector, {1.35, 0, 0}, 0.5)));
   GridLayoutOptions options;
   options.particles = 1000;
   const GridLayoutResult layout = layout_particle_grid(patch, options);

@@ -8,9 +8,12 @@
 #include <Eigen/Geometry>
 #include <cmath>
 #include <functional>
+#include <sstream>
+#include <string>
 
 #include "elastic/mesh/polygon_mesh.h"
 #include "elastic/particles/particle_grid.h"
+#include "elastic/projection/closest_point.h"
 #include "elastic/regions/region.h"
 #include "elastic/surface/limit_surface.h"
 
@@ -99,6 +102,18 @@ inline void expect_valid_faces(const ParticleGrid& grid, const LimitSurface& sur
     }
   }
   EXPECT_GT(smallest, min_sine);
+}
+
+/// A "disk:X,Y,Z,R" region spec centred at the surface point nearest to `near` (control meshes of
+/// convex shapes lie outside their limit surfaces, so a point of the ideal shape may be too far
+/// from it).
+inline std::string disk_spec(const SurfaceProjector& projector, const Eigen::Vector3d& near,
+                             double radius) {
+  const Eigen::Vector3d c = projector.closest(near).position;
+  std::ostringstream out;
+  out.precision(17);
+  out << "disk:" << c.x() << "," << c.y() << "," << c.z() << "," << radius;
+  return out.str();
 }
 
 }  // namespace elastic::test

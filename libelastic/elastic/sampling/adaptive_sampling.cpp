@@ -139,12 +139,13 @@ AdaptiveSamplingResult adaptive_sampling(const ParticleGrid& input, const Region
   std::vector<SurfacePoint>& sp = grid.source_points;
   std::vector<Eigen::Vector3d> normal(np);
   std::vector<double> r(np);
-  auto evaluate_curvature = [&](int p) {
-    const SurfaceCurvature c = surface.curvature(sp[p]);
-    normal[p] = c.normal;
-    r[p] = std::sqrt(0.5 * (c.k1 * c.k1 + c.k2 * c.k2));
+  // Normal and curvature weight r = sqrt((k1^2 + k2^2) / 2) at a surface point.
+  auto weight_at = [&](const SurfacePoint& q, Eigen::Vector3d& n, double& w) {
+    const SurfaceCurvature c = surface.curvature(q);
+    n = c.normal;
+    w = std::sqrt(0.5 * (c.k1 * c.k1 + c.k2 * c.k2));
   };
-  tbb::parallel_for(0, np, evaluate_curvature);
+  tbb::parallel_for(0, np, [&](int p) { weight_at(sp[p], normal[p], r[p]); });
 
   auto mean_spring_length = [&] {
     double sum = 0.0;
@@ -174,6 +175,8 @@ AdaptiveSamplingResult adaptive_sampling(const ParticleGrid& input, const Region
   std::vector<Eigen::Vector3d> new_x(np);
   std::vector<SurfacePoint> new_sp(np);
   std::vector<double> new_s(np, 0.0);
+  std::vector<Eigen::Vector3d> new_normal(np);
+  std::vector<double> new_r(np, 0.0);
   std::vector<char> moving(np, 0);
   long rejected = 0;
 
@@ -195,6 +198,10 @@ AdaptiveSamplingResult adaptive_sampling(const ParticleGrid& input, const Region
   };
 
   auto accept_moves = [&]() {
+    // Normals and weights at the candidate positions, in parallel; acceptance is sequential.
+    tbb::parallel_for(0, np, [&](int p) {
+      if (moving[p]) weight_at(new_sp[p], new_normal[p], new_r[p]);
+    });
     double largest = 0.0;
     for (int p = 0; p < np; ++p) {
       if (!moving[p]) continue;
@@ -204,10 +211,14 @@ AdaptiveSamplingResult adaptive_sampling(const ParticleGrid& input, const Region
       const SurfacePoint old_sp = sp[p];
       bool ok = false;
       for (int attempt = 0; attempt < 2 && !ok; ++attempt) {
-        if (attempt == 1) halfway(p);
+        if (attempt == 1) {
+          halfway(p);
+          weight_at(new_sp[p], new_normal[p], new_r[p]);
+        }
         x[p] = new_x[p];
         sp[p] = new_sp[p];
-        evaluate_curvature(p);
+        normal[p] = new_normal[p];
+        r[p] = new_r[p];
         const double after = min_sine_around(p);
         ok = after > 0.0 && (after > options.min_corner_sine || after >= before);
       }
