@@ -4,20 +4,42 @@
 ///
 /// An Embree point query (`rtcPointQuery`) over a dense tessellation of the limit surface finds the
 /// nearest tessellation triangle; the triangle's vertex SurfacePoints give a starting (face, u, v);
-/// Newton iterations on the patch, minimising |d(u,v) - x|^2 and walking across ptex edges when a step
-/// leaves the face (LimitSurface::walk), make the answer exact to round-off. The warm-started form skips
-/// the BVH and starts Newton from a previous SurfacePoint (a particle's last position), falling back to
-/// the BVH when Newton does not converge near the hint.
+/// Newton iterations on the patch, minimising |d(u,v) - x|^2 and walking across ptex edges when a
+/// step leaves the face (LimitSurface::walk), make the answer exact to round-off. The warm-started
+/// form skips the BVH and starts Newton from a previous SurfacePoint (a particle's last position),
+/// falling back to the BVH when Newton does not converge near the hint.
 ///
 /// Behaviour at the edges of the problem:
-/// - On an open surface the closest point may lie on the boundary curve; Newton is then constrained to
+/// - On an open surface the closest point may lie on the boundary curve; Newton is then constrained
+/// to
 ///   the boundary edge and `on_boundary` is set.
-/// - Far from the surface the answer is still the global closest point (the BVH has no radius limit).
+/// - Far from the surface the answer is still the global closest point (the BVH has no radius
+/// limit).
 /// - A non-finite query point throws InvalidInputError.
 ///
-/// Ownership and threads: a SurfaceProjector keeps a reference to the LimitSurface, which must outlive it,
-/// and owns its tessellation and Embree scene. It can be moved, not copied. All const queries are
-/// thread-safe; the batched form runs on all threads of the TBB arena it is called from.
+/// Seeding: the tessellation triangles' vertices carry SurfacePoints of whichever ptex face they
+/// were welded from; the projector re-expresses each triangle's corners in the triangle's own ptex
+/// face
+/// (`triangle_face`) as nodes of that face's uniform grid, once, at construction, so a seed is the
+/// barycentric blend of three (u, v) in one face.
+///
+/// Global query: BVH closest triangle -> Newton -> answer at distance D. The limit surface lies
+/// within about `eps` of the tessellation (`eps` estimated at construction from the triangle
+/// centroids), so only triangles closer than D + eps can hide a closer limit point; a second BVH
+/// query collects them and Newton runs from up to `max_global_seeds` of those not next to the
+/// answer. The minimum wins.
+///
+/// Warm start: the answer is the local minimum of the distance that Newton reaches from the hint.
+/// It is the global closest point when the query is closer to the surface than the medial axis
+/// (particles that move a little per step); it falls back to the global query when Newton does not
+/// converge or travels farther than `warm_start_max_travel`. An unset hint (face -1) means "no
+/// hint".
+///
+/// Ownership and threads: a SurfaceProjector keeps a reference to the LimitSurface, which must
+/// outlive it, and owns its tessellation and Embree scene. It can be moved, not copied. All const
+/// queries are thread-safe (Embree point queries on a committed scene are); the batched form runs
+/// on all threads of the TBB arena it is called from. One Embree device is shared by all projectors
+/// of the process; it is created with the first projector and released with the last.
 
 #include <Eigen/Core>
 #include <memory>
@@ -29,12 +51,21 @@
 namespace elastic {
 
 struct ProjectionOptions {
-  /// Tessellation the BVH is built on (finer gives a better Newton seed, costs memory and build time).
+  /// Tessellation the BVH is built on (finer gives a better Newton seed, costs memory and build
+  /// time).
   TessellationOptions tessellation{.resolution = 4, .target_triangles = 0};
   /// Newton iterations before giving up on a seed.
   int max_newton_iterations = 30;
   /// Stop when the parameter step is below this (in ptex units; 1e-12 is near double round-off).
   double parameter_tolerance = 1e-12;
+  /// Largest Newton step, in ptex units (a face is 1 wide); longer steps are shortened to this.
+  double max_step = 0.5;
+  /// Warm start is distrusted (and the global query used) when Newton's path from the hint is
+  /// longer than this, in ptex units summed over the steps, or when it does not converge.
+  double warm_start_max_travel = 1.0;
+  /// Global query: at most this many BVH candidates (triangles that may hide a closer limit point
+  /// than the first answer) get their own Newton run.
+  int max_global_seeds = 8;
 };
 
 /// The closest point on the limit surface to a query point.
@@ -50,6 +81,7 @@ struct ClosestPoint {
 class SurfaceProjector {
  public:
   /// Builds the tessellation and the Embree scene for `surface` (which must outlive the projector).
+  /// \throws InvalidInputError when the options are out of range; Error when Embree fails.
   explicit SurfaceProjector(const LimitSurface& surface, const ProjectionOptions& options = {});
   ~SurfaceProjector();
   SurfaceProjector(SurfaceProjector&&) noexcept;
@@ -61,11 +93,17 @@ class SurfaceProjector {
   const LimitTessellation& tessellation() const;
 
   /// Global closest point (BVH seed + Newton).
+  /// \throws InvalidInputError (naming the surface) when x is not finite.
   ClosestPoint closest(const Eigen::Vector3d& x) const;
   /// Warm-started closest point: Newton from `hint`; falls back to the global query when needed.
+  /// \throws InvalidInputError when x is not finite, or the hint is set but is not a point of the
+  ///         surface (face out of range, (u, v) outside the face's domain).
   ClosestPoint closest(const Eigen::Vector3d& x, const SurfacePoint& hint) const;
   /// Batched form: out[i] = closest(xs[i]) or closest(xs[i], hints[i]) when `hints` is not empty.
-  /// Runs in parallel. `out` and `hints` (if given) must have xs.size() entries.
+  /// Runs in parallel; gives the same results as the single queries.
+  /// \throws InvalidInputError as the single queries do, or when `out` or a non-empty `hints` does
+  /// not
+  ///         have xs.size() entries.
   void closest(std::span<const Eigen::Vector3d> xs, std::span<ClosestPoint> out,
                std::span<const SurfacePoint> hints = {}) const;
 
