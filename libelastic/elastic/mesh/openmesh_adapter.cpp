@@ -22,9 +22,14 @@ HalfedgeMesh to_openmesh(const PolygonMesh& mesh, const ToOpenMeshOptions& optio
     std::string s;
     for (const auto& e : examples) {
       if constexpr (std::is_same_v<std::decay_t<decltype(e)>, int>) {
-        s += " " + std::to_string(e);
+        s += ' ';
+        s += std::to_string(e);
       } else {
-        s += " (" + std::to_string(e.first) + ", " + std::to_string(e.second) + ")";
+        s += " (";
+        s += std::to_string(e.first);
+        s += ", ";
+        s += std::to_string(e.second);
+        s += ')';
       }
     }
     return s;
