@@ -59,8 +59,8 @@ TEST(TriangleLocator2D, OutsideIsNotFoundAndNearestClamps) {
   // Far away: still the right corner.
   const auto far = locator.nearest({-100.0, -50.0});
   const Eigen::Vector3i& ft = t[far.triangle];
-  const Eigen::Vector2d fq = far.barycentric[0] * v[ft[0]] + far.barycentric[1] * v[ft[1]] +
-                             far.barycentric[2] * v[ft[2]];
+  const Eigen::Vector2d fq =
+      far.barycentric[0] * v[ft[0]] + far.barycentric[1] * v[ft[1]] + far.barycentric[2] * v[ft[2]];
   EXPECT_LT(fq.norm(), 1e-14);
 }
 

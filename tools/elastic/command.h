@@ -1,6 +1,6 @@
 #pragma once
-// Subcommand registry of the `elastic` tool. Each subcommand lives in its own cmd_<name>.cpp and registers
-// itself with ELASTIC_COMMAND; main.cpp builds the CLI11 app from the registry.
+// Subcommand registry of the `elastic` tool. Each subcommand lives in its own cmd_<name>.cpp and
+// registers itself with ELASTIC_COMMAND; main.cpp builds the CLI11 app from the registry.
 
 #include <CLI/CLI.hpp>
 #include <functional>
@@ -37,6 +37,6 @@ struct CommandRegistrar {
 #define ELASTIC_CONCAT_INNER(a, b) a##b
 #define ELASTIC_CONCAT(a, b) ELASTIC_CONCAT_INNER(a, b)
 /// ELASTIC_COMMAND("name", "description", [](CLI::App& sub) { ...; return [&]{ return 0; }; });
-#define ELASTIC_COMMAND(name, description, setup)                                        \
-  static const ::elastic::cli::CommandRegistrar ELASTIC_CONCAT(elastic_command_, __LINE__)( \
-      ::elastic::cli::Command{name, description, setup})
+#define ELASTIC_COMMAND(name, description, setup)               \
+  static const ::elastic::cli::CommandRegistrar ELASTIC_CONCAT( \
+      elastic_command_, __LINE__)(::elastic::cli::Command{name, description, setup})

@@ -1,4 +1,5 @@
-// The `elastic` command-line tool. Library errors become one line on stderr and a documented exit code.
+// The `elastic` command-line tool. Library errors become one line on stderr and a documented exit
+// code.
 
 #include <cstdio>
 #include <exception>
@@ -17,7 +18,9 @@ std::vector<Command>& command_registry() {
 
 int main(int argc, char** argv) {
   using namespace elastic::cli;
-  CLI::App app{"ElasticPaint: paste features from a region of one surface onto another with least distortion"};
+  CLI::App app{
+      "ElasticPaint: paste features from a region of one surface onto another with least "
+      "distortion"};
   app.set_version_flag("--version", ELASTIC_VERSION);
   app.require_subcommand(1);
 

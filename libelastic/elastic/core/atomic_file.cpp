@@ -1,5 +1,7 @@
 #include "elastic/core/atomic_file.h"
 
+#include <unistd.h>
+
 #include <atomic>
 #include <cerrno>
 #include <cstring>
@@ -7,8 +9,6 @@
 #include <system_error>
 
 #include "elastic/core/error.h"
-
-#include <unistd.h>
 
 namespace elastic {
 

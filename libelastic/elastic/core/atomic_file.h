@@ -1,8 +1,8 @@
 #pragma once
 /// \file
-/// Writing a file so that a reader never sees a partial one and a good file is never replaced by a broken
-/// one: the content goes to a temporary file in the same directory, which is renamed over the destination
-/// only after everything was written and flushed successfully.
+/// Writing a file so that a reader never sees a partial one and a good file is never replaced by a
+/// broken one: the content goes to a temporary file in the same directory, which is renamed over
+/// the destination only after everything was written and flushed successfully.
 
 #include <filesystem>
 #include <fstream>

@@ -1,12 +1,13 @@
 #pragma once
 /// \file
-/// The library's exception hierarchy. Every error names the input it is about (a file path, a flag, a
-/// mesh name) and says what is wrong with it, so that a tool can print `what()` as one line for the user.
+/// The library's exception hierarchy. Every error names the input it is about (a file path, a flag,
+/// a mesh name) and says what is wrong with it, so that a tool can print `what()` as one line for
+/// the user.
 ///
 ///   Error                    base of everything the library throws on purpose
-///   ├── IoError              a file cannot be opened, read or written (missing, permission, disk full)
-///   ├── InvalidInputError    the input is readable but wrong: malformed file, non-manifold mesh,
-///   │                        NaN coordinates, a curve off the surface, an absurd count, ...
+///   ├── IoError              a file cannot be opened, read or written (missing, permission, disk
+///   full) ├── InvalidInputError    the input is readable but wrong: malformed file, non-manifold
+///   mesh, │                        NaN coordinates, a curve off the surface, an absurd count, ...
 ///   └── NumericalError       a computation failed on valid input (no convergence, singular system)
 ///
 /// `what()` is "<input>: <problem>"; `input()` and `problem()` give the two parts.

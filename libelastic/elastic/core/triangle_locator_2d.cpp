@@ -44,7 +44,8 @@ TriangleLocator2D::TriangleLocator2D(std::vector<Eigen::Vector2d> vertices,
   for (size_t c = 1; c < counts.size(); ++c) counts[c] += counts[c - 1];
   cell_start_ = counts;
   cell_items_.resize(counts.back());
-  for (int t = 0; t < num_triangles(); ++t) for_each_cell(t, [&](int c) { cell_items_[counts[c]++] = t; });
+  for (int t = 0; t < num_triangles(); ++t)
+    for_each_cell(t, [&](int c) { cell_items_[counts[c]++] = t; });
 }
 
 void TriangleLocator2D::cell_range(const Eigen::Vector2d& lo, const Eigen::Vector2d& hi, int& x0,
@@ -102,7 +103,8 @@ TriangleLocator2D::Hit TriangleLocator2D::locate(const Eigen::Vector2d& p, doubl
 
 namespace {
 // Closest point of segment [a,b] to p, as the parameter along it.
-double segment_parameter(const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Eigen::Vector2d& p) {
+double segment_parameter(const Eigen::Vector2d& a, const Eigen::Vector2d& b,
+                         const Eigen::Vector2d& p) {
   const Eigen::Vector2d ab = b - a;
   const double len2 = ab.squaredNorm();
   return len2 > 0.0 ? std::clamp((p - a).dot(ab) / len2, 0.0, 1.0) : 0.0;
@@ -115,8 +117,10 @@ TriangleLocator2D::Hit TriangleLocator2D::nearest(const Eigen::Vector2d& p) cons
   // Search rings of cells outward until a candidate is found and the ring is farther than the best.
   Hit best;
   double best_d2 = std::numeric_limits<double>::infinity();
-  const int cx = std::clamp(static_cast<int>(std::floor((p.x() - origin_.x()) / cell_size_)), 0, nx_ - 1);
-  const int cy = std::clamp(static_cast<int>(std::floor((p.y() - origin_.y()) / cell_size_)), 0, ny_ - 1);
+  const int cx =
+      std::clamp(static_cast<int>(std::floor((p.x() - origin_.x()) / cell_size_)), 0, nx_ - 1);
+  const int cy =
+      std::clamp(static_cast<int>(std::floor((p.y() - origin_.y()) / cell_size_)), 0, ny_ - 1);
   const Eigen::Vector2d clamped(std::clamp(p.x(), origin_.x(), origin_.x() + nx_ * cell_size_),
                                 std::clamp(p.y(), origin_.y(), origin_.y() + ny_ * cell_size_));
   const double outside = (p - clamped).norm();

@@ -1,15 +1,15 @@
 #pragma once
 /// \file
-/// Point location in a planar triangle mesh: which triangle contains a 2D point, and its barycentric
-/// coordinates there. A uniform bucket grid over the triangles' bounding boxes makes a query O(1) on
-/// average for meshes of roughly uniform triangle size (the flattened regions and particle grids it is
-/// used on).
+/// Point location in a planar triangle mesh: which triangle contains a 2D point, and its
+/// barycentric coordinates there. A uniform bucket grid over the triangles' bounding boxes makes a
+/// query O(1) on average for meshes of roughly uniform triangle size (the flattened regions and
+/// particle grids it is used on).
 ///
-/// Points outside every triangle (by more than the tolerance) are reported as not found, never guessed;
-/// `nearest` gives the closest triangle instead when a caller wants to clamp.
+/// Points outside every triangle (by more than the tolerance) are reported as not found, never
+/// guessed; `nearest` gives the closest triangle instead when a caller wants to clamp.
 ///
-/// The locator copies the vertex positions and triangles; it is immutable after construction and its
-/// queries are thread-safe.
+/// The locator copies the vertex positions and triangles; it is immutable after construction and
+/// its queries are thread-safe.
 
 #include <Eigen/Core>
 #include <vector>
@@ -19,8 +19,9 @@ namespace elastic {
 class TriangleLocator2D {
  public:
   struct Hit {
-    int triangle = -1;                               ///< -1 when the point is in no triangle
-    Eigen::Vector3d barycentric = Eigen::Vector3d::Zero();  ///< weights of the triangle's corners 0,1,2
+    int triangle = -1;  ///< -1 when the point is in no triangle
+    Eigen::Vector3d barycentric =
+        Eigen::Vector3d::Zero();  ///< weights of the triangle's corners 0,1,2
     bool found() const { return triangle >= 0; }
   };
 
@@ -49,7 +50,8 @@ class TriangleLocator2D {
   double cell_size_ = 1.0;
   int nx_ = 0;
   int ny_ = 0;
-  std::vector<int> cell_start_;  // CSR: triangles overlapping cell c are cell_items_[cell_start_[c]..[c+1])
+  std::vector<int>
+      cell_start_;  // CSR: triangles overlapping cell c are cell_items_[cell_start_[c]..[c+1])
   std::vector<int> cell_items_;
 };
 

@@ -1,0 +1,229 @@
+#include "elastic/mapping/initial_map.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <numbers>
+
+#include "elastic/core/error.h"
+#include "elastic/core/triangle_locator_2d.h"
+
+namespace elastic {
+
+struct RegionDiskMap::Locators {
+  TriangleLocator2D disk;                        // region triangles in disk coordinates
+  std::vector<std::vector<int>> face_triangles;  // ptex face -> region triangles inside it
+  std::vector<double> boundary_arc;    // cumulative arc length at each boundary vertex, / total
+  std::vector<int> boundary_triangle;  // region triangle holding boundary edge k -> k+1
+  std::vector<Eigen::Vector2i> boundary_corners;  // that triangle's corner indices of the edge ends
+};
+
+namespace {
+
+// Barycentric coordinates of p in the triangle (a, b, c); NaN for a degenerate triangle.
+Eigen::Vector3d barycentric(const Eigen::Vector2d& a, const Eigen::Vector2d& b,
+                            const Eigen::Vector2d& c, const Eigen::Vector2d& p) {
+  const Eigen::Vector2d e1 = b - a, e2 = c - a, d = p - a;
+  const double det = e1.x() * e2.y() - e1.y() * e2.x();
+  if (det == 0.0) return Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
+  const double b1 = (d.x() * e2.y() - d.y() * e2.x()) / det;
+  const double b2 = (e1.x() * d.y() - e1.y() * d.x()) / det;
+  return {1.0 - b1 - b2, b1, b2};
+}
+
+// Squared distance from p to triangle (a, b, c) in 3D and the barycentrics of the closest point.
+double closest_on_triangle(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
+                           const Eigen::Vector3d& b, const Eigen::Vector3d& c, Eigen::Vector3d& w) {
+  // Project onto the plane, then clamp to the edges when outside (enough for a fallback search).
+  const Eigen::Vector3d ab = b - a, ac = c - a, ap = p - a;
+  const double d00 = ab.dot(ab), d01 = ab.dot(ac), d11 = ac.dot(ac);
+  const double d20 = ap.dot(ab), d21 = ap.dot(ac);
+  const double det = d00 * d11 - d01 * d01;
+  if (det > 0.0) {
+    const double v = (d11 * d20 - d01 * d21) / det;
+    const double u = (d00 * d21 - d01 * d20) / det;
+    if (v >= 0.0 && u >= 0.0 && u + v <= 1.0) {
+      w = {1.0 - u - v, v, u};
+      return (a + v * ab + u * ac - p).squaredNorm();
+    }
+  }
+  double best = std::numeric_limits<double>::infinity();
+  const Eigen::Vector3d corners[3] = {a, b, c};
+  for (int e = 0; e < 3; ++e) {
+    const Eigen::Vector3d& s0 = corners[e];
+    const Eigen::Vector3d& s1 = corners[(e + 1) % 3];
+    const Eigen::Vector3d d = s1 - s0;
+    const double len2 = d.squaredNorm();
+    const double t = len2 > 0.0 ? std::clamp((p - s0).dot(d) / len2, 0.0, 1.0) : 0.0;
+    const double dist = (s0 + t * d - p).squaredNorm();
+    if (dist < best) {
+      best = dist;
+      w.setZero();
+      w[e] = 1.0 - t;
+      w[(e + 1) % 3] = t;
+    }
+  }
+  return best;
+}
+
+}  // namespace
+
+RegionDiskMap::RegionDiskMap(const Region& region) : region_(&region) {
+  if (region.surface == nullptr || region.triangles.empty() || region.boundary.size() < 3) {
+    throw InvalidInputError("region", "region is empty or has no boundary");
+  }
+  flattening_ = flatten_region(region, {.method = FlatteningMethod::Disk});
+  auto locators = std::make_shared<Locators>();
+  locators->disk = TriangleLocator2D(flattening_.uv, region.triangles);
+  locators->face_triangles.resize(region.surface->num_faces());
+  for (int t = 0; t < region.num_triangles(); ++t) {
+    locators->face_triangles[region.triangle_face[t]].push_back(t);
+  }
+
+  // Boundary: arc lengths and, for each boundary edge, the triangle that holds it.
+  const int n = static_cast<int>(region.boundary.size());
+  std::map<std::pair<int, int>, std::pair<int, Eigen::Vector2i>> edge_triangle;
+  for (int t = 0; t < region.num_triangles(); ++t) {
+    for (int k = 0; k < 3; ++k) {
+      edge_triangle[{region.triangles[t][k], region.triangles[t][(k + 1) % 3]}] = {
+          t, Eigen::Vector2i(k, (k + 1) % 3)};
+    }
+  }
+  locators->boundary_arc.resize(n + 1, 0.0);
+  locators->boundary_triangle.resize(n);
+  locators->boundary_corners.resize(n);
+  for (int k = 0; k < n; ++k) {
+    const int a = region.boundary[k], b = region.boundary[(k + 1) % n];
+    locators->boundary_arc[k + 1] =
+        locators->boundary_arc[k] + (region.positions[b] - region.positions[a]).norm();
+    // The boundary runs counter-clockwise, like the triangles, so edge a->b is a triangle's own
+    // edge.
+    auto it = edge_triangle.find({a, b});
+    if (it == edge_triangle.end()) {
+      throw InvalidInputError("region", "boundary edge is not an edge of a region triangle");
+    }
+    locators->boundary_triangle[k] = it->second.first;
+    locators->boundary_corners[k] = it->second.second;
+  }
+  const double total = locators->boundary_arc[n];
+  if (!(total > 0.0)) throw InvalidInputError("region", "boundary has zero length");
+  for (double& a : locators->boundary_arc) a /= total;
+  locators_ = std::move(locators);
+}
+
+bool RegionDiskMap::to_disk(const SurfacePoint& p, Eigen::Vector2d& disk) const {
+  const Region& region = *region_;
+  auto interpolate = [&](int t, const Eigen::Vector3d& w) {
+    const Eigen::Vector3i& tri = region.triangles[t];
+    disk = w[0] * flattening_.uv[tri[0]] + w[1] * flattening_.uv[tri[1]] +
+           w[2] * flattening_.uv[tri[2]];
+  };
+  // In the point's own ptex face: the region triangle containing (u, v), deepest first.
+  if (p.face >= 0 && p.face < static_cast<int>(locators_->face_triangles.size())) {
+    int best = -1;
+    double best_min = -1e-9;  // parameter-space slack for points on triangle edges
+    Eigen::Vector3d best_w;
+    for (int t : locators_->face_triangles[p.face]) {
+      const auto& uv = region.triangle_uv[t];
+      const Eigen::Vector3d w = barycentric(uv[0], uv[1], uv[2], p.uv());
+      if (!w.allFinite()) continue;
+      if (w.minCoeff() > best_min) {
+        best_min = w.minCoeff();
+        best = t;
+        best_w = w;
+      }
+    }
+    if (best >= 0) {
+      interpolate(best, best_w.cwiseMax(0.0) / best_w.cwiseMax(0.0).sum());
+      return true;
+    }
+  }
+  // A point on a ptex edge may be written in the neighbouring face: fall back to the nearest region
+  // triangle in 3D, accepted when the point is within round-off of it.
+  const Eigen::Vector3d x = region.surface->position(p);
+  double best_d2 = std::numeric_limits<double>::infinity();
+  int best = -1;
+  Eigen::Vector3d best_w;
+  for (int t = 0; t < region.num_triangles(); ++t) {
+    const Eigen::Vector3i& tri = region.triangles[t];
+    Eigen::Vector3d w;
+    const double d2 = closest_on_triangle(x, region.positions[tri[0]], region.positions[tri[1]],
+                                          region.positions[tri[2]], w);
+    if (d2 < best_d2) {
+      best_d2 = d2;
+      best = t;
+      best_w = w;
+    }
+  }
+  if (best < 0) return false;
+  // Accept points within a small fraction of the triangle's size (chord error of the tessellation).
+  const Eigen::Vector3i& tri = region.triangles[best];
+  const double size = (region.positions[tri[1]] - region.positions[tri[0]]).norm() +
+                      (region.positions[tri[2]] - region.positions[tri[0]]).norm();
+  if (best_d2 > (0.05 * size) * (0.05 * size)) return false;
+  interpolate(best, best_w);
+  return true;
+}
+
+bool RegionDiskMap::from_disk(const Eigen::Vector2d& disk, SurfacePoint& p,
+                              double tolerance) const {
+  if (!disk.allFinite() || disk.norm() > 1.0 + tolerance) return false;
+  TriangleLocator2D::Hit hit = locators_->disk.locate(disk, 1e-12);
+  if (!hit.found())
+    hit = locators_->disk.nearest(disk);  // between the circle and its inscribed polygon
+  if (!hit.found()) return false;
+  p = region_->point_in_triangle(hit.triangle, hit.barycentric[1], hit.barycentric[2]);
+  return true;
+}
+
+SurfacePoint RegionDiskMap::boundary_point(double s) const {
+  const Region& region = *region_;
+  const std::vector<double>& arc = locators_->boundary_arc;
+  const int n = static_cast<int>(region.boundary.size());
+  double a = std::fmod(region.anchor + s, 1.0);
+  if (a < 0.0) a += 1.0;
+  // Segment k with arc[k] <= a < arc[k+1].
+  const int k = std::clamp(
+      static_cast<int>(std::upper_bound(arc.begin(), arc.end(), a) - arc.begin()) - 1, 0, n - 1);
+  const double span = arc[k + 1] - arc[k];
+  const double t = span > 0.0 ? std::clamp((a - arc[k]) / span, 0.0, 1.0) : 0.0;
+  Eigen::Vector3d w = Eigen::Vector3d::Zero();
+  w[locators_->boundary_corners[k][0]] = 1.0 - t;
+  w[locators_->boundary_corners[k][1]] = t;
+  return region.point_in_triangle(locators_->boundary_triangle[k], w[1], w[2]);
+}
+
+InitialMap naive_map(const ParticleGrid& grid, const RegionDiskMap& source,
+                     const RegionDiskMap& target) {
+  const int n = grid.num_particles();
+  InitialMap result;
+  result.positions.resize(3, n);
+  result.points.resize(n);
+  const LimitSurface& surface = *target.region().surface;
+  std::vector<double> parameter(n, -1.0);
+  for (size_t k = 0; k < grid.boundary_loop.size(); ++k) {
+    parameter[grid.boundary_loop[k]] = grid.boundary_parameter[k];
+  }
+  for (int i = 0; i < n; ++i) {
+    SurfacePoint q;
+    if (parameter[i] >= 0.0) {
+      q = target.boundary_point(parameter[i]);
+    } else {
+      Eigen::Vector2d disk;
+      if (!source.to_disk(grid.source_points[i], disk)) {
+        ++result.outside;
+        disk.setZero();  // keep the particle inside the target region; counted as outside
+      }
+      if (!target.from_disk(disk, q)) {
+        ++result.outside;
+        target.from_disk(Eigen::Vector2d::Zero(), q);
+      }
+    }
+    result.points[i] = q;
+    result.positions.col(i) = surface.position(q);
+  }
+  return result;
+}
+
+}  // namespace elastic

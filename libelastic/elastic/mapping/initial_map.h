@@ -1,0 +1,61 @@
+#pragma once
+/// \file
+/// The paper's "naive mapping" (Fig. 9a): the starting configuration of the relaxation, and a
+/// baseline.
+///
+/// Both regions are mapped to the unit disk by `flatten_region` (Disk: mean-value coordinates,
+/// boundary on the circle by normalised arc length from the anchor), and the two disk maps are
+/// composed: source point -> source disk -> target disk (the same point) -> target surface. Each
+/// disk map is a bijection of the region onto the disk, so the composition is bijective and
+/// orientation-preserving (both boundaries are counter-clockwise seen from their normals). Boundary
+/// particles land at their correspondence parameter s on the target curve (angle 2 pi s), so the
+/// boundary correspondence is the arc-length one of §4.1 by construction.
+
+#include <Eigen/Core>
+#include <memory>
+#include <vector>
+
+#include "elastic/particles/particle_grid.h"
+#include "elastic/regions/region.h"
+#include "elastic/regions/region_flattening.h"
+
+namespace elastic {
+
+/// Where a region point lies on the region's disk map, and back.
+class RegionDiskMap {
+ public:
+  RegionDiskMap() = default;
+  /// Flattens `region` to the unit disk. The region must outlive the map.
+  explicit RegionDiskMap(const Region& region);
+
+  const Region& region() const { return *region_; }
+  const RegionFlattening& flattening() const { return flattening_; }
+
+  /// Disk coordinates of a surface point of the region; false when the point is not in the region.
+  bool to_disk(const SurfacePoint& p, Eigen::Vector2d& disk) const;
+  /// The region's surface point at disk coordinates `disk` (clamped to the disk); false when the
+  /// point is farther than `tolerance` outside the disk.
+  bool from_disk(const Eigen::Vector2d& disk, SurfacePoint& p, double tolerance = 1e-9) const;
+  /// The point of the boundary curve at correspondence parameter s (angle 2 pi s on the disk).
+  SurfacePoint boundary_point(double s) const;
+
+ private:
+  const Region* region_ = nullptr;
+  RegionFlattening flattening_;
+  struct Locators;
+  std::shared_ptr<const Locators> locators_;
+};
+
+struct InitialMap {
+  Eigen::Matrix3Xd positions;  ///< 3 x #P target positions (exactly on the target limit surface)
+  std::vector<SurfacePoint> points;  ///< #P target surface points
+  int outside =
+      0;  ///< particles whose source point could not be placed in the source region's disk map
+};
+
+/// Places every particle of `grid` (which lies on `source`) on `target` by the composed disk maps.
+/// \throws NumericalError when a disk map cannot be built.
+InitialMap naive_map(const ParticleGrid& grid, const RegionDiskMap& source,
+                     const RegionDiskMap& target);
+
+}  // namespace elastic

@@ -1,0 +1,83 @@
+#include "elastic/mapping/map_regions.h"
+
+#include <chrono>
+
+#include "elastic/core/error.h"
+
+namespace elastic {
+
+namespace {
+double seconds_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+}  // namespace
+
+MapResult map_regions(const SurfaceProjector& source, const Region& source_region,
+                      const SurfaceProjector& target, const Region& target_region,
+                      const MapOptions& options) {
+  if (source_region.surface != &source.surface()) {
+    throw InvalidInputError("source region", "does not lie on the source surface");
+  }
+  if (target_region.surface != &target.surface()) {
+    throw InvalidInputError("target region", "does not lie on the target surface");
+  }
+  auto stage = [&](std::string_view name) {
+    if (!report_progress(options.progress, {.stage = name})) {
+      throw Error("map", "cancelled during " + std::string(name));
+    }
+  };
+  MapResult result;
+
+  // 1. Particles on the source (§4.1, §4.3).
+  stage("sample");
+  auto start = std::chrono::steady_clock::now();
+  result.sampling = sample_region(source_region, source, options.sampling);
+  result.seconds_sampling = seconds_since(start);
+  const ParticleGrid& grid = result.sampling.grid;
+
+  // 2. The naive map: both regions to the unit disk, composed (Fig. 9a).
+  stage("naive map");
+  start = std::chrono::steady_clock::now();
+  result.source_disk = std::make_unique<RegionDiskMap>(source_region);
+  result.target_disk = std::make_unique<RegionDiskMap>(target_region);
+  result.naive = naive_map(grid, *result.source_disk, *result.target_disk);
+  if (result.naive.outside > 0) {
+    throw NumericalError("map", std::to_string(result.naive.outside) +
+                                    " particles could not be placed in the target region");
+  }
+  result.seconds_naive = seconds_since(start);
+
+  // 3. Rest scale sigma between the two regions' sizes.
+  const RegionSizes sizes{.source_boundary_length = source_region.boundary_curve().length(),
+                          .target_boundary_length = target_region.boundary_curve().length(),
+                          .source_area = source_region.area(),
+                          .target_area = target_region.area()};
+  result.rest_scale = rest_scale_factor(options.rest_scale, sizes);
+
+  // 4. Relaxation on the target (§4.2, §4.4-4.6). Boundary particles stay at their arc-length
+  // positions.
+  stage("relax");
+  RelaxationProblem problem;
+  problem.grid = &grid;
+  problem.target = &target;
+  problem.initial_positions = result.naive.positions;
+  problem.initial_points = result.naive.points;
+  problem.rest_scale = result.rest_scale;
+  problem.rest_scale_mode = options.rest_scale;
+  problem.boundary_targets.resize(3, static_cast<Eigen::Index>(grid.boundary_loop.size()));
+  for (size_t k = 0; k < grid.boundary_loop.size(); ++k) {
+    problem.boundary_targets.col(static_cast<Eigen::Index>(k)) =
+        result.naive.positions.col(grid.boundary_loop[k]);
+  }
+  result.relaxation = relax(problem, options.relaxation);
+
+  // 5. The queryable mapping.
+  stage("mapping");
+  start = std::chrono::steady_clock::now();
+  result.mapping = Mapping(grid, source, *result.source_disk, target, *result.target_disk,
+                           result.relaxation.points);
+  result.seconds_mapping = seconds_since(start);
+  return result;
+}
+
+}  // namespace elastic

@@ -1,0 +1,67 @@
+#pragma once
+/// \file
+/// The whole mapping job of the paper in one call: sample the source region with particles (§4.1,
+/// §4.3), place them on the target by the naive map (Fig. 9a), relax them to least distortion
+/// (§4.2, §4.4-4.6), and return a queryable `Mapping` together with everything a report needs.
+///
+/// Example:
+///
+///     const LimitSurface plane(make_plane()), cap(make_cap());
+///     const SurfaceProjector source(plane), target(cap);
+///     const Region from = make_region(source, parse_region_spec("boundary"));
+///     const Region to = make_region(target, parse_region_spec("boundary"));
+///     MapOptions options;
+///     options.sampling.layout.particles = 5775;
+///     const MapResult result = map_regions(source, from, target, to, options);
+///     // result.relaxation.length_energy, result.mapping.forward(p), ...
+
+#include <memory>
+#include <string>
+
+#include "elastic/core/progress.h"
+#include "elastic/mapping/initial_map.h"
+#include "elastic/mapping/mapping.h"
+#include "elastic/regions/region.h"
+#include "elastic/sampling/sample_region.h"
+#include "elastic/solvers/relaxation.h"
+
+namespace elastic {
+
+struct MapOptions {
+  /// Particle count, layout and curvature-adaptive sampling on the source
+  /// (sampling/sample_region.h).
+  SampleRegionOptions sampling;
+  /// Solver, stiffnesses, tolerances, threads, callbacks (solvers/relaxation.h).
+  RelaxationOptions relaxation;
+  /// How rest lengths are scaled between source and target sizes (particles/spring_energy.h).
+  RestScale rest_scale = RestScale::Boundary;
+  /// Called between stages ("sample", "naive map", "relax", "mapping"); return false to cancel.
+  ProgressCallback progress;
+};
+
+struct MapResult {
+  SampleRegionResult sampling;    ///< the particle grid on the source and its statistics
+  InitialMap naive;               ///< the starting placement on the target (the naive map)
+  RelaxationResult relaxation;    ///< the relaxed placement and the solver's report
+  double rest_scale = 1.0;        ///< sigma actually used
+  double seconds_sampling = 0.0;  ///< source sampling (layout + adaptive sampling + springs)
+  double seconds_naive = 0.0;     ///< disk maps of both regions + naive placement
+  double seconds_mapping = 0.0;   ///< building the queryable mapping
+  /// Disk maps of the two regions (owned here so `mapping` can reference them).
+  std::unique_ptr<RegionDiskMap> source_disk;
+  std::unique_ptr<RegionDiskMap> target_disk;
+  /// The relaxed map, queryable both ways. References the projectors, the regions and the disk maps
+  /// above.
+  Mapping mapping;
+};
+
+/// Maps `source_region` (on `source`) onto `target_region` (on `target`).
+/// The regions must lie on the projectors' surfaces and outlive the result, as must the projectors.
+/// \throws InvalidInputError for inconsistent inputs or options (naming them); NumericalError when
+/// a
+///         stage fails numerically.
+MapResult map_regions(const SurfaceProjector& source, const Region& source_region,
+                      const SurfaceProjector& target, const Region& target_region,
+                      const MapOptions& options = {});
+
+}  // namespace elastic

@@ -1,0 +1,118 @@
+// The whole mapping pipeline: sample -> naive map -> relax -> queryable Mapping.
+#include "elastic/mapping/map_regions.h"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <random>
+
+#include "elastic/regions/region_spec.h"
+#include "elastic/shapes/procedural_shapes.h"
+
+namespace elastic {
+namespace {
+
+PolygonMesh moved(PolygonMesh mesh, const Eigen::Isometry3d& motion) {
+  for (Eigen::Vector3d& p : mesh.positions) p = motion * p;
+  return mesh;
+}
+
+Eigen::Isometry3d some_rigid_motion() {
+  Eigen::Isometry3d m = Eigen::Isometry3d::Identity();
+  m.rotate(Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized()));
+  m.pretranslate(Eigen::Vector3d(0.3, -1.2, 2.5));
+  return m;
+}
+
+// A disk on a plane mapped onto the same disk on a rigidly moved copy of the plane: the map must be
+// the rigid motion (the zero of the length and angle energies; congruent regions, congruent
+// anchors).
+TEST(MapRegions, PlaneOntoRigidlyMovedCopyIsTheRigidMotion) {
+  const PolygonMesh plane = make_plane({.faces = ShapeFaces::Quads, .resolution = 12});
+  const Eigen::Isometry3d motion = some_rigid_motion();
+  const LimitSurface source_surface(plane), target_surface(moved(plane, motion));
+  const SurfaceProjector source(source_surface), target(target_surface);
+  RegionSpec source_spec = parse_region_spec("disk:0.1,0.05,0,0.6");
+  source_spec.anchor = Eigen::Vector3d(1, 0, 0);
+  RegionSpec target_spec = source_spec;
+  target_spec.center = motion * source_spec.center;
+  target_spec.anchor = motion * *source_spec.anchor;
+  const Region from = make_region(source, source_spec);
+  const Region to = make_region(target, target_spec);
+
+  MapOptions options;
+  options.sampling.layout.particles = 400;
+  const MapResult result = map_regions(source, from, target, to, options);
+  ASSERT_TRUE(result.relaxation.converged) << to_string(result.relaxation.reason);
+  EXPECT_EQ(result.relaxation.folded_faces, 0);
+  const ParticleGrid& grid = result.sampling.grid;
+  const Eigen::Matrix3Xd expected = motion * grid.source_positions();
+  // 1e-8 of the region's size (diameter 1.2): the energy's zero is the rigid motion; the solver
+  // stops at a relative gradient of 1e-6, and the boundary correspondence is exact up to the cut's
+  // round-off.
+  const double error = (result.relaxation.positions - expected).colwise().norm().maxCoeff();
+  EXPECT_LT(error, 1e-8) << "largest deviation from the rigid motion";
+  EXPECT_LT(result.relaxation.length_energy, 1e-14);
+  EXPECT_NEAR(result.rest_scale, 1.0, 1e-9);
+}
+
+// The whole plane square onto the cap: converges, no folds, boundary particles exactly where the
+// arc-length correspondence put them, and relaxation lowers the energy of the naive map.
+TEST(MapRegions, PlaneOntoCapConvergesWithoutFolds) {
+  const LimitSurface source_surface(make_plane({.resolution = 8}));
+  const LimitSurface target_surface(make_cap({.resolution = 16}));
+  const SurfaceProjector source(source_surface), target(target_surface);
+  const Region from = make_region(source, parse_region_spec("boundary"));
+  const Region to = make_region(target, parse_region_spec("boundary"));
+  MapOptions options;
+  options.sampling.layout.particles = 600;
+  const MapResult result = map_regions(source, from, target, to, options);
+  const RelaxationResult& r = result.relaxation;
+  EXPECT_TRUE(r.converged) << to_string(r.reason);
+  EXPECT_EQ(r.folded_faces, 0);
+  EXPECT_LT(r.boundary_residual, 1e-12);
+  EXPECT_LT(r.length_energy + r.angular_energy, r.initial_energy);
+  EXPECT_NEAR(static_cast<double>(result.sampling.grid.num_particles()), 600.0, 30.0);
+  // Every particle is on the target surface.
+  for (int i = 0; i < result.sampling.grid.num_particles(); ++i) {
+    EXPECT_LT((target_surface.position(r.points[i]) - r.positions.col(i)).norm(), 1e-9);
+  }
+}
+
+// Forward then inverse returns near the start (the two directions interpolate the same grid through
+// different disk maps, so they agree to the grid's interpolation error, not to round-off); points
+// outside the region answer "outside".
+TEST(MapRegions, MappingAnswersBothWays) {
+  const LimitSurface source_surface(make_plane({.resolution = 8}));
+  const LimitSurface target_surface(make_cylinder({.resolution = 24}));
+  const SurfaceProjector source(source_surface), target(target_surface);
+  const Region from = make_region(source, parse_region_spec("disk:0,0,0,0.5"));
+  const Region to = make_region(target, parse_region_spec("disk:0.5,0,0,0.5"));
+  MapOptions options;
+  options.sampling.layout.particles = 800;
+  const MapResult result = map_regions(source, from, target, to, options);
+  ASSERT_TRUE(result.relaxation.converged);
+  const double spacing = result.sampling.statistics.spacing_median;
+
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> angle(0.0, 6.283185307179586), radius(0.0, 0.4);
+  int checked = 0;
+  for (int k = 0; k < 200; ++k) {
+    const double a = angle(rng), r = radius(rng);
+    const ClosestPoint p = source.closest(Eigen::Vector3d(r * std::cos(a), r * std::sin(a), 0.0));
+    const Mapping::Location there = result.mapping.forward(p.point);
+    ASSERT_TRUE(there.inside) << "interior point " << k << " not mapped";
+    EXPECT_LT((target_surface.position(there.point) - there.position).norm(), 1e-9);
+    const Mapping::Location back = result.mapping.inverse(there.point);
+    ASSERT_TRUE(back.inside);
+    EXPECT_LT((back.position - p.position).norm(), 0.05 * spacing);
+    ++checked;
+  }
+  EXPECT_EQ(checked, 200);
+  // Outside the source disk, and outside the target disk.
+  EXPECT_FALSE(result.mapping.forward(source.closest(Eigen::Vector3d(0.9, 0.9, 0)).point).inside);
+  EXPECT_FALSE(result.mapping.inverse(target.closest(Eigen::Vector3d(-0.5, 0, 0)).point).inside);
+}
+
+}  // namespace
+}  // namespace elastic

@@ -1,0 +1,49 @@
+#pragma once
+// Shared pieces of the subcommands: loading a surface from a mesh file, a progress line on
+// terminals.
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "elastic/core/progress.h"
+#include "elastic/mesh/polygon_mesh.h"
+#include "elastic/projection/closest_point.h"
+#include "elastic/surface/limit_surface.h"
+
+namespace elastic::cli {
+
+/// A mesh file turned into a limit surface and its magnet. Heap-held so the references between them
+/// stay valid when the struct moves.
+struct LoadedSurface {
+  std::string path;
+  std::unique_ptr<PolygonMesh> mesh;
+  std::unique_ptr<LimitSurface> surface;
+  std::unique_ptr<SurfaceProjector> projector;
+  std::vector<std::string> warnings;  ///< reader and repair warnings, for the user
+};
+
+/// Reads, sanitises (repairs what is safely repairable, rejects the rest), and builds the limit
+/// surface and the projector. `scheme` is "auto", "loop" or "catmull-clark".
+LoadedSurface load_surface(const std::string& path, const std::string& scheme = "auto");
+
+/// A progress callback that redraws one status line on stderr when stderr is a terminal and `quiet`
+/// is false; otherwise an empty callback (nothing goes into pipes or files).
+ProgressCallback terminal_progress(bool quiet);
+/// Ends the status line (if one was drawn).
+void end_progress_line();
+
+/// Prints warnings to stderr ("elastic: warning: ...") unless quiet.
+void print_warnings(const std::vector<std::string>& warnings, bool quiet);
+
+}  // namespace elastic::cli
+
+#include <Eigen/Core>
+
+#include "elastic/particles/particle_grid.h"
+
+namespace elastic::cli {
+/// The particle grid's faces with the given 3 x #P particle positions, as a PolygonMesh for
+/// writing.
+PolygonMesh grid_polygon_mesh(const ParticleGrid& grid, const Eigen::Matrix3Xd& positions);
+}  // namespace elastic::cli

@@ -1,0 +1,180 @@
+// `elastic info MESH`: mesh statistics, validation findings, and the limit surface's curvature
+// statistics.
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+#include <nlohmann/json.hpp>
+#include <numbers>
+
+#include "command.h"
+#include "elastic/core/atomic_file.h"
+#include "elastic/mesh/mesh_io.h"
+#include "elastic/mesh/mesh_validation.h"
+#include "elastic/surface/limit_surface.h"
+#include "elastic/surface/limit_tessellation.h"
+
+namespace elastic::cli {
+namespace {
+
+struct InfoArgs {
+  std::string mesh;
+  std::string scheme = "auto";
+  int resolution = 8;
+  std::string json;
+  bool repair = true;
+};
+
+struct Stats {
+  double min = 0, median = 0, max = 0, mean = 0;
+};
+
+Stats stats_of(std::vector<double> values) {
+  Stats s;
+  if (values.empty()) return s;
+  std::sort(values.begin(), values.end());
+  s.min = values.front();
+  s.max = values.back();
+  s.median = values[values.size() / 2];
+  double sum = 0;
+  for (double v : values) sum += v;
+  s.mean = sum / static_cast<double>(values.size());
+  return s;
+}
+
+nlohmann::json to_json(const Stats& s) {
+  return {{"min", s.min}, {"median", s.median}, {"max", s.max}, {"mean", s.mean}};
+}
+
+int run_info(const InfoArgs& args) {
+  MeshReadResult read = read_mesh(args.mesh);
+  PolygonMesh& mesh = read.mesh;
+  const MeshValidation before = validate_mesh(mesh);
+  std::vector<std::string> warnings = read.warnings;
+  if (args.repair) {
+    SanitizeResult sanitized = sanitize_mesh(mesh, args.mesh);
+    warnings.insert(warnings.end(), sanitized.warnings.begin(), sanitized.warnings.end());
+  } else {
+    require_valid_manifold(mesh, args.mesh);
+  }
+  const MeshValidation v = validate_mesh(mesh);
+
+  LimitSurfaceOptions options;
+  options.name = args.mesh;
+  if (args.scheme == "loop") options.scheme = SubdivisionScheme::Loop;
+  if (args.scheme == "catmull-clark") options.scheme = SubdivisionScheme::CatmullClark;
+  const LimitSurface surface(mesh, options);
+  const LimitTessellation tess = tessellate(surface, {.resolution = args.resolution});
+
+  // Curvature at every tessellation vertex; integrated Gaussian curvature by vertex areas (one
+  // third of the incident triangles' areas) to check Gauss-Bonnet on closed surfaces: integral K dA
+  // = 2 pi chi.
+  const size_t n = tess.positions.size();
+  std::vector<double> k1(n), k2(n), mean(n), gauss(n), r(n), area(n, 0.0);
+  for (const Eigen::Vector3i& t : tess.triangles) {
+    const double a = 0.5 * (tess.positions[t[1]] - tess.positions[t[0]])
+                               .cross(tess.positions[t[2]] - tess.positions[t[0]])
+                               .norm();
+    for (int k = 0; k < 3; ++k) area[t[k]] += a / 3.0;
+  }
+  double total_area = 0, integral_gauss = 0;
+  for (size_t i = 0; i < n; ++i) {
+    const SurfaceCurvature c = surface.curvature(tess.points[i]);
+    k1[i] = c.k1;
+    k2[i] = c.k2;
+    mean[i] = c.mean;
+    gauss[i] = c.gaussian;
+    r[i] = std::sqrt(0.5 * (c.k1 * c.k1 + c.k2 * c.k2));  // the sampling weight of eq. 8
+    total_area += area[i];
+    integral_gauss += c.gaussian * area[i];
+  }
+  Eigen::Vector3d lo = tess.positions.front(), hi = lo;
+  for (const auto& p : tess.positions) {
+    lo = lo.cwiseMin(p);
+    hi = hi.cwiseMax(p);
+  }
+
+  const char* scheme = surface.scheme() == SubdivisionScheme::Loop ? "loop" : "catmull-clark";
+  nlohmann::json report = {
+      {"mesh", args.mesh},
+      {"vertices", v.num_vertices},
+      {"faces", v.num_faces},
+      {"edges", v.num_edges},
+      {"boundary_loops", v.num_boundary_loops},
+      {"components", v.num_components},
+      {"euler_characteristic", v.euler_characteristic},
+      {"genus", v.genus},
+      {"triangles_only", mesh.is_triangle_mesh()},
+      {"quads_only", mesh.is_quad_mesh()},
+      {"texcoords", mesh.has_texcoords()},
+      {"findings_before_repair", before.describe()},
+      {"warnings", warnings},
+      {"limit_surface",
+       {{"scheme", scheme},
+        {"ptex_faces", surface.num_faces()},
+        {"tessellation_triangles", tess.triangles.size()},
+        {"area", total_area},
+        {"bbox_min", {lo.x(), lo.y(), lo.z()}},
+        {"bbox_max", {hi.x(), hi.y(), hi.z()}},
+        {"k1", to_json(stats_of(k1))},
+        {"k2", to_json(stats_of(k2))},
+        {"mean_curvature", to_json(stats_of(mean))},
+        {"gaussian_curvature", to_json(stats_of(gauss))},
+        {"sampling_weight_r", to_json(stats_of(r))},
+        {"integrated_gaussian_curvature", integral_gauss},
+        {"gauss_bonnet_2pi_chi",
+         v.is_closed() ? nlohmann::json(2.0 * std::numbers::pi * v.euler_characteristic)
+                       : nlohmann::json(nullptr)}}}};
+
+  if (!args.json.empty()) {
+    write_file_atomically(args.json, [&](std::ofstream& out) { out << report.dump(2) << '\n'; });
+  }
+
+  auto line = [](const char* name, const Stats& s) {
+    std::cout << "  " << std::left << std::setw(22) << name << std::right << std::setprecision(4)
+              << " min " << std::setw(10) << s.min << "  median " << std::setw(10) << s.median
+              << "  max " << std::setw(10) << s.max << '\n';
+  };
+  std::cout << args.mesh << '\n'
+            << "  " << v.num_vertices << " vertices, " << v.num_faces << " faces, " << v.num_edges
+            << " edges, " << v.num_boundary_loops << " boundary loops, " << v.num_components
+            << " component(s), chi = " << v.euler_characteristic << ", genus " << v.genus << '\n';
+  for (const std::string& w : warnings) std::cout << "  warning: " << w << '\n';
+  std::cout << "limit surface: " << scheme << ", " << surface.num_faces() << " ptex faces, area "
+            << std::setprecision(6) << total_area << ", curvature over " << n
+            << " tessellation vertices:\n";
+  line("k1", stats_of(k1));
+  line("k2", stats_of(k2));
+  line("mean curvature H", stats_of(mean));
+  line("Gaussian curvature K", stats_of(gauss));
+  line("sampling weight r", stats_of(r));
+  std::cout << "  integral of K dA = " << std::setprecision(6) << integral_gauss;
+  if (v.is_closed()) {
+    std::cout << "  (Gauss-Bonnet: 2 pi chi = " << 2.0 * std::numbers::pi * v.euler_characteristic
+              << ")";
+  }
+  std::cout << '\n';
+  return kOk;
+}
+
+}  // namespace
+}  // namespace elastic::cli
+
+ELASTIC_COMMAND(
+    "info", "Mesh statistics, validation and limit-surface curvature", [](CLI::App& sub) {
+      auto args = std::make_shared<elastic::cli::InfoArgs>();
+      sub.add_option("mesh", args->mesh, "Mesh file (OBJ, OFF, PLY, STL)")->required();
+      sub.add_option("--scheme", args->scheme, "Subdivision scheme")
+          ->check(CLI::IsMember({"auto", "loop", "catmull-clark"}));
+      sub.add_option("--resolution", args->resolution, "Tessellation segments per ptex edge")
+          ->check(CLI::Range(1, 256));
+      sub.add_option("--json", args->json, "Also write the statistics as JSON to this file");
+      sub.add_flag("!--no-repair", args->repair, "Fail on repairable defects instead of repairing");
+      sub.footer(
+          "Example:\n  elastic info meshes/torus_quads.obj --json torus.json\n"
+          "prints vertex/face counts, validation findings, and the limit surface's principal,\n"
+          "mean and Gaussian curvature statistics with a Gauss-Bonnet check on closed surfaces.");
+      return [args] { return elastic::cli::run_info(*args); };
+    });
