@@ -790,6 +790,8 @@ void LimitSurface::Impl::evaluate(const SurfacePoint& p, SurfaceDerivatives& out
   const Far::PatchTable::PatchHandle* handle = patch_map->FindPatch(p.face, uv.x(), uv.y());
   if (!handle) throw NumericalError(name, "no patch at ptex face " + std::to_string(p.face));
   const PatchRecord& rec = patches[static_cast<size_t>(handle->patchIndex)];
+  static_assert(sizeof(Eigen::Vector3d) == 3 * sizeof(double),
+                "control points are read as xyz triples");
   const Eigen::Vector3d* cp = patch_points.data() + rec.first_point;
 
   if (rec.kind == PatchKind::BSpline) {
@@ -800,32 +802,35 @@ void LimitSurface::Impl::evaluate(const SurfacePoint& p, SurfaceDerivatives& out
     double bs[4], ds[4], dds[4], bt[4], dt[4], ddt[4];
     bspline_basis(s, bs, kDerivatives ? ds : nullptr, kDerivatives ? dds : nullptr);
     bspline_basis(t, bt, kDerivatives ? dt : nullptr, kDerivatives ? ddt : nullptr);
-    Eigen::Vector3d pos = Eigen::Vector3d::Zero();
-    Eigen::Vector3d du = Eigen::Vector3d::Zero(), dv = Eigen::Vector3d::Zero();
-    Eigen::Vector3d duu = Eigen::Vector3d::Zero(), duv = Eigen::Vector3d::Zero();
-    Eigen::Vector3d dvv = Eigen::Vector3d::Zero();
+    // Plain arrays: the control points are 16 consecutive xyz triples.
+    const double* q = cp->data();
+    double pos[3] = {0, 0, 0}, du[3] = {0, 0, 0}, dv[3] = {0, 0, 0};
+    double duu[3] = {0, 0, 0}, duv[3] = {0, 0, 0}, dvv[3] = {0, 0, 0};
     for (int row = 0; row < 4; ++row) {
-      const Eigen::Vector3d* r = cp + 4 * row;
-      const Eigen::Vector3d r0 = bs[0] * r[0] + bs[1] * r[1] + bs[2] * r[2] + bs[3] * r[3];
-      pos += bt[row] * r0;
-      if constexpr (kDerivatives) {
-        const Eigen::Vector3d r1 = ds[0] * r[0] + ds[1] * r[1] + ds[2] * r[2] + ds[3] * r[3];
-        const Eigen::Vector3d r2 = dds[0] * r[0] + dds[1] * r[1] + dds[2] * r[2] + dds[3] * r[3];
-        du += bt[row] * r1;
-        dv += dt[row] * r0;
-        duu += bt[row] * r2;
-        duv += dt[row] * r1;
-        dvv += ddt[row] * r0;
+      const double* r = q + 12 * row;
+      for (int c = 0; c < 3; ++c) {
+        const double r0 = bs[0] * r[c] + bs[1] * r[3 + c] + bs[2] * r[6 + c] + bs[3] * r[9 + c];
+        pos[c] += bt[row] * r0;
+        if constexpr (kDerivatives) {
+          const double r1 = ds[0] * r[c] + ds[1] * r[3 + c] + ds[2] * r[6 + c] + ds[3] * r[9 + c];
+          const double r2 =
+              dds[0] * r[c] + dds[1] * r[3 + c] + dds[2] * r[6 + c] + dds[3] * r[9 + c];
+          du[c] += bt[row] * r1;
+          dv[c] += dt[row] * r0;
+          duu[c] += bt[row] * r2;
+          duv[c] += dt[row] * r1;
+          dvv[c] += ddt[row] * r0;
+        }
       }
     }
-    out.position = pos;
+    out.position = {pos[0], pos[1], pos[2]};
     if constexpr (kDerivatives) {
       const double k1 = rec.scale, k2 = rec.scale * rec.scale;
-      out.du = k1 * du;
-      out.dv = k1 * dv;
-      out.duu = k2 * duu;
-      out.duv = k2 * duv;
-      out.dvv = k2 * dvv;
+      out.du = {k1 * du[0], k1 * du[1], k1 * du[2]};
+      out.dv = {k1 * dv[0], k1 * dv[1], k1 * dv[2]};
+      out.duu = {k2 * duu[0], k2 * duu[1], k2 * duu[2]};
+      out.duv = {k2 * duv[0], k2 * duv[1], k2 * duv[2]};
+      out.dvv = {k2 * dvv[0], k2 * dvv[1], k2 * dvv[2]};
     }
     return;
   }
@@ -842,28 +847,30 @@ void LimitSurface::Impl::evaluate(const SurfacePoint& p, SurfaceDerivatives& out
     } else {
       gregory_triangle_basis(s, t, w);
     }
-    Eigen::Vector3d pos = Eigen::Vector3d::Zero();
-    Eigen::Vector3d du = Eigen::Vector3d::Zero(), dv = Eigen::Vector3d::Zero();
-    Eigen::Vector3d duu = Eigen::Vector3d::Zero(), duv = Eigen::Vector3d::Zero();
-    Eigen::Vector3d dvv = Eigen::Vector3d::Zero();
+    const double* q = cp->data();
+    double pos[3] = {0, 0, 0}, du[3] = {0, 0, 0}, dv[3] = {0, 0, 0};
+    double duu[3] = {0, 0, 0}, duv[3] = {0, 0, 0}, dvv[3] = {0, 0, 0};
     for (int i = 0; i < rec.num_points; ++i) {
-      pos += w[i].f * cp[i];
-      if constexpr (kDerivatives) {
-        du += w[i].fs * cp[i];
-        dv += w[i].ft * cp[i];
-        duu += w[i].fss * cp[i];
-        duv += w[i].fst * cp[i];
-        dvv += w[i].ftt * cp[i];
+      for (int c = 0; c < 3; ++c) {
+        const double x = q[3 * i + c];
+        pos[c] += w[i].f * x;
+        if constexpr (kDerivatives) {
+          du[c] += w[i].fs * x;
+          dv[c] += w[i].ft * x;
+          duu[c] += w[i].fss * x;
+          duv[c] += w[i].fst * x;
+          dvv[c] += w[i].ftt * x;
+        }
       }
     }
-    out.position = pos;
+    out.position = {pos[0], pos[1], pos[2]};
     if constexpr (kDerivatives) {
       const double k1 = sign * rec.scale, k2 = rec.scale * rec.scale;
-      out.du = k1 * du;
-      out.dv = k1 * dv;
-      out.duu = k2 * duu;
-      out.duv = k2 * duv;
-      out.dvv = k2 * dvv;
+      out.du = {k1 * du[0], k1 * du[1], k1 * du[2]};
+      out.dv = {k1 * dv[0], k1 * dv[1], k1 * dv[2]};
+      out.duu = {k2 * duu[0], k2 * duu[1], k2 * duu[2]};
+      out.duv = {k2 * duv[0], k2 * duv[1], k2 * duv[2]};
+      out.dvv = {k2 * dvv[0], k2 * dvv[1], k2 * dvv[2]};
     }
     return;
   }
@@ -876,32 +883,34 @@ void LimitSurface::Impl::evaluate(const SurfacePoint& p, SurfaceDerivatives& out
   } else {
     patch_table->EvaluateBasis(*handle, uv.x(), uv.y(), w);
   }
-  Eigen::Vector3d pos = Eigen::Vector3d::Zero();
-  Eigen::Vector3d du = Eigen::Vector3d::Zero(), dv = Eigen::Vector3d::Zero();
-  Eigen::Vector3d duu = Eigen::Vector3d::Zero(), duv = Eigen::Vector3d::Zero();
-  Eigen::Vector3d dvv = Eigen::Vector3d::Zero();
+  const double* q = cp->data();
+  double pos[3] = {0, 0, 0}, du[3] = {0, 0, 0}, dv[3] = {0, 0, 0};
+  double duu[3] = {0, 0, 0}, duv[3] = {0, 0, 0}, dvv[3] = {0, 0, 0};
   for (int i = 0; i < rec.num_points; ++i) {
-    pos += w[i] * cp[i];
-    if constexpr (kDerivatives) {
-      du += wu[i] * cp[i];
-      dv += wv[i] * cp[i];
-      duu += wuu[i] * cp[i];
-      duv += wuv[i] * cp[i];
-      dvv += wvv[i] * cp[i];
+    for (int c = 0; c < 3; ++c) {
+      const double x = q[3 * i + c];
+      pos[c] += w[i] * x;
+      if constexpr (kDerivatives) {
+        du[c] += wu[i] * x;
+        dv[c] += wv[i] * x;
+        duu[c] += wuu[i] * x;
+        duv[c] += wuv[i] * x;
+        dvv[c] += wvv[i] * x;
+      }
     }
   }
-  out.position = pos;
+  out.position = {pos[0], pos[1], pos[2]};
   if constexpr (kDerivatives) {
     // OpenSubdiv 3.5/3.6 scale the second-derivative weights of a rotated triangle patch by
     // -4^depth (the sign of the first-derivative chain rule applied once more); the chain rule for
     // s = c - 2^depth u gives +4^depth. Undo the sign here.
     const double k1 = rec.derivative_fix;
     const double k2 = rec.derivative_fix * rec.derivative_fix * (rec.rotated_triangle ? -1.0 : 1.0);
-    out.du = k1 * du;
-    out.dv = k1 * dv;
-    out.duu = k2 * duu;
-    out.duv = k2 * duv;
-    out.dvv = k2 * dvv;
+    out.du = {k1 * du[0], k1 * du[1], k1 * du[2]};
+    out.dv = {k1 * dv[0], k1 * dv[1], k1 * dv[2]};
+    out.duu = {k2 * duu[0], k2 * duu[1], k2 * duu[2]};
+    out.duv = {k2 * duv[0], k2 * duv[1], k2 * duv[2]};
+    out.dvv = {k2 * dvv[0], k2 * dvv[1], k2 * dvv[2]};
   }
 }
 
