@@ -692,8 +692,8 @@ PolygonMesh make_vase(const ShapeOptions& options) {
 }
 
 // Goblet profile (r, z), one open surface from the centre of the foot's underside to the cup's rim:
-// a slightly concave underside (centre raised to z = 0.03) out to the foot's edge (radius 0.52), a
-// rounded edge 0.06 thick, the foot's top rising into a thin stem (radius 0.06 for z in
+// a slightly concave underside (centre raised to z = 0.03) out to the foot's edge (radius 0.53), a
+// rounded edge ~0.08 thick, the foot's top rising into a thin stem (radius 0.06 for z in
 // 0.38..0.55), a knot, and a cup whose wall bulges to radius 0.49 at z ~ 1.2 and narrows slightly
 // to the rim (radius 0.44 at z = 1.55). The cup is a single sheet: its inside is the back of its
 // outside.
