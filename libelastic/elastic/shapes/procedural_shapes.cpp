@@ -157,12 +157,13 @@ RingLayout layout_rings(const Profile& profile, int n, double step_factor, int m
                         bool even_count) {
   const int dense = std::max(4096, 16 * n);
   std::vector<Eigen::Vector2d> p(static_cast<size_t>(dense) + 1);
-  RingLayout layout;
-  layout.dense_t.resize(p.size());
+  std::vector<double> dense_t(p.size());
   for (int k = 0; k <= dense; ++k) {
-    layout.dense_t[k] = static_cast<double>(k) / dense;
-    p[k] = profile.at(layout.dense_t[k]);
+    dense_t[k] = static_cast<double>(k) / dense;
+    p[k] = profile.at(dense_t[k]);
   }
+  RingLayout layout;
+  layout.dense_t = std::move(dense_t);
   double max_radius = 0.0;
   for (const Eigen::Vector2d& q : p) max_radius = std::max(max_radius, q.x());
   layout.pole_radius = 0.5 * max_radius;
