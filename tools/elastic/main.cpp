@@ -43,7 +43,7 @@ int main(int argc, char** argv) {
     return run ? run() : kUsage;
   } catch (const elastic::IoError& e) {
     std::cerr << "elastic: " << e.what() << '\n';
-    return kNoInput;
+    return e.direction() == elastic::IoError::Direction::Write ? kCantCreate : kNoInput;
   } catch (const elastic::InvalidInputError& e) {
     std::cerr << "elastic: " << e.what() << '\n';
     return kBadInput;

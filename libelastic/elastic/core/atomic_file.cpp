@@ -27,7 +27,8 @@ void write_file_atomically(const std::filesystem::path& path,
   {
     std::ofstream out(tmp, binary ? std::ios::out | std::ios::binary : std::ios::out);
     if (!out) {
-      throw IoError(path.string(), std::string("cannot create file: ") + std::strerror(errno));
+      throw IoError(path.string(), std::string("cannot create file: ") + std::strerror(errno),
+                    IoError::Direction::Write);
     }
     try {
       write(out);
@@ -41,7 +42,8 @@ void write_file_atomically(const std::filesystem::path& path,
     if (!out) {
       std::error_code ignored;
       std::filesystem::remove(tmp, ignored);
-      throw IoError(path.string(), "write failed (disk full or I/O error)");
+      throw IoError(path.string(), "write failed (disk full or I/O error)",
+                    IoError::Direction::Write);
     }
   }
   std::error_code ec;
@@ -49,7 +51,8 @@ void write_file_atomically(const std::filesystem::path& path,
   if (ec) {
     std::error_code ignored;
     std::filesystem::remove(tmp, ignored);
-    throw IoError(path.string(), "cannot replace file: " + ec.message());
+    throw IoError(path.string(), "cannot replace file: " + ec.message(),
+                  IoError::Direction::Write);
   }
 }
 

@@ -34,10 +34,17 @@ class Error : public std::runtime_error {
   std::string problem_;
 };
 
-/// A file could not be opened, read or written.
+/// A file could not be opened, read or written. `direction()` tells which, so a tool can tell a missing
+/// input from an output it cannot create.
 class IoError : public Error {
  public:
-  using Error::Error;
+  enum class Direction { Read, Write };
+  IoError(std::string input, std::string problem, Direction direction = Direction::Read)
+      : Error(std::move(input), std::move(problem)), direction_(direction) {}
+  Direction direction() const noexcept { return direction_; }
+
+ private:
+  Direction direction_;
 };
 
 /// The input is readable but not acceptable (malformed, non-manifold, out of range, ...).
