@@ -480,6 +480,19 @@ TEST(LimitSurface, SharedSpotControlMesh) {
   expect_limit_consistent(s);
 }
 
+TEST(LimitSurface, SharedNonManifoldMeshIsRejected) {
+  // 9 non-manifold edges, a non-manifold vertex, faces with repeated vertices (README of the shared
+  // meshes): OpenSubdiv would accept it, the LimitSurface must not.
+  ELASTIC_REQUIRE_SHARED_MESH(path, "osd_catmark_nonman_edges.obj");
+  const PolygonMesh mesh = read_mesh(path).mesh;
+  try {
+    const LimitSurface s(mesh, {.name = path.string()});
+    ADD_FAILURE() << "accepted a non-manifold mesh";
+  } catch (const InvalidInputError& e) {
+    EXPECT_EQ(e.input(), path.string());
+  }
+}
+
 // --- Errors
 // ----------------------------------------------------------------------------------------
 
