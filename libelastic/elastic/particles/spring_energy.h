@@ -5,23 +5,23 @@
 ///
 /// With x_i the 3D target position of particle i (3 x #P matrix `x`), sigma the rest scale:
 ///
-/// - normal springs (eq. 13, Appendix):  E_len = C * sum_{springs (i,j)} (|x_j - x_i| - sigma
-/// k_ij)^2
+/// - normal springs (eq. 13, Appendix):
+///       E_len = C * sum_{springs (i,j)} (|x_j - x_i| - sigma k_ij)^2
 ///   gradient on j: 2C (|d| - sigma k) d/|d| with d = x_j - x_i, and its negative on i. The paper's
 ///   eq. 14 writes this force as C d/|d| (|d| - k): its C is our 2C (eq. 13 sums every spring
 ///   twice, once from each end, we sum it once).
-/// - angular springs (§4.1, Fig. 1): E_ang = C_a * sum_{corners (i; a, b)} (|x_i - (x_a + x_b)/2| -
-/// sigma r_i)^2
+/// - angular springs (§4.1, Fig. 1):
+///       E_ang = C_a * sum_{corners (i; a, b)} (|x_i - (x_a + x_b)/2| - sigma r_i)^2
 ///   gradient on i: g = 2C_a (|e| - sigma r) e/|e| with e = x_i - (x_a + x_b)/2; on a and on b
 ///   exactly -g/2 (the virtual midpoint moves by half of what a or b moves). These are the paper's
 ///   "opposite force with half the magnitude" on the two neighbours, and the three sum to zero: the
 ///   springs conserve momentum.
-/// - magnet (§4.4, Appendix): E_mag = c/2 * sum_i |x_i - x'_i|^2 with x'_i the closest point of the
-/// surface.
+/// - magnet (§4.4, Appendix):
+///       E_mag = c/2 * sum_i |x_i - x'_i|^2,   x'_i the closest point of the surface to x_i.
 ///   Half the squared distance to a smooth surface has gradient x - x' (the closest point moves,
-///   but only along the surface, orthogonally to x - x': envelope theorem), so the gradient is c (x
-///   - x'), the paper's f^m = c (x' - x) as a force. The paper writes the energy without the 1/2;
-///   we keep the force.
+///   but only along the surface, orthogonally to x - x': envelope theorem), so the gradient is
+///   c (x - x'), the paper's force f^m = c (x' - x). The paper writes the energy without the 1/2;
+///   we keep its force.
 ///
 /// Degenerate springs: at |d| = 0 (or |e| = 0) the energy has a cone point and no gradient; that
 /// spring then contributes zero to the gradient (a valid subgradient choice that keeps the sum of

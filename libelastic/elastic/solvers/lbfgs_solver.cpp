@@ -1,6 +1,7 @@
 #include "elastic/solvers/lbfgs_solver.h"
 
 #include <Eigen/SparseCholesky>
+#include <algorithm>
 #include <cmath>
 #include <deque>
 #include <limits>
@@ -13,6 +14,11 @@ namespace elastic {
 namespace {
 
 using solver_detail::RelaxationSetup;
+
+// Rounds of blocking fold-making particles per line search before the step is halved instead.
+constexpr int kMaxBlockRounds = 8;
+// Consecutive steps without an energy change beyond round-off before the solver gives up.
+constexpr int kMaxStalled = 20;
 
 // Interior vectors have 3n entries laid out as an n x 3 column-major matrix (all x, then all y,
 // then all z), so that the Laplacian solve takes the three coordinates as three right-hand sides.
@@ -102,6 +108,9 @@ RelaxationResult relax_lbfgs(const RelaxationProblem& problem, const RelaxationO
   const long long solve_start = solver_detail::now_ticks();
 
   std::deque<Pair> memory;
+  std::vector<char> blocked(static_cast<std::size_t>(n), 0);  // free particles held back this step
+  bool last_blocked = false;
+  int stalled = 0;  // consecutive steps that changed the energy by less than its round-off
   std::vector<Eigen::Vector3d> trial_query(static_cast<std::size_t>(n));
   std::vector<SurfacePoint> hints(static_cast<std::size_t>(n));
   std::vector<ClosestPoint> projected(static_cast<std::size_t>(n));
@@ -124,6 +133,23 @@ RelaxationResult relax_lbfgs(const RelaxationProblem& problem, const RelaxationO
     }
     if (q_norm <= setup.absolute_bound) {
       result.reason = StopReason::AbsoluteGradient;
+      break;
+    }
+    if (last_blocked) {
+      // Particles were held back from folding a face in the last step. If every other particle is
+      // at equilibrium, the energy minimum lies beyond the no-fold constraint: stop and say so.
+      double free_sum = 0.0;
+      for (Eigen::Index k = 0; k < n; ++k)
+        if (!blocked[static_cast<std::size_t>(k)]) free_sum += layout.at(q, k).squaredNorm();
+      const double free_norm = std::sqrt(free_sum);
+      if (free_norm <= options.relative_gradient_tolerance * initial_norm ||
+          free_norm <= setup.absolute_bound) {
+        result.reason = StopReason::FoldConstrained;
+        break;
+      }
+    }
+    if (stalled >= kMaxStalled) {
+      result.reason = StopReason::LineSearchFailed;
       break;
     }
     if (iteration >= max_iterations) break;
@@ -170,7 +196,9 @@ RelaxationResult relax_lbfgs(const RelaxationProblem& problem, const RelaxationO
     double alpha = 1.0;
     SpringEnergies trial_energies;
     Eigen::VectorXd trial_q;
-    for (int backtrack = 0; backtrack < lb.max_backtracks; ++backtrack, alpha *= 0.5) {
+    std::fill(blocked.begin(), blocked.end(), 0);
+    int backtracks = 0, block_rounds = 0;
+    while (backtracks < lb.max_backtracks && slope < 0.0) {
       trial_q.resize(0);
       for (Eigen::Index k = 0; k < n; ++k)
         trial_query[static_cast<std::size_t>(k)] =
@@ -186,23 +214,47 @@ RelaxationResult relax_lbfgs(const RelaxationProblem& problem, const RelaxationO
       }
       setup.springs.folded_corners(trial_positions, trial_normals, trial_folded);
       bool new_fold = false;
-      for (std::size_t c = 0; c < folded.size() && !new_fold; ++c)
-        new_fold = trial_folded[c] && !folded[c];
-      if (new_fold) continue;
+      for (std::size_t c = 0; c < folded.size(); ++c) {
+        if (!trial_folded[c] || folded[c]) continue;
+        new_fold = true;
+        if (block_rounds >= kMaxBlockRounds) break;
+        // Block the free particles of the newly folded corner: they keep their position this step.
+        const SpringSystem::Corner& corner = setup.springs.corners()[c];
+        for (const int p : {corner.i, corner.next, corner.prev}) {
+          const int k = setup.interior_index[static_cast<std::size_t>(p)];
+          if (k < 0 || blocked[static_cast<std::size_t>(k)]) continue;
+          blocked[static_cast<std::size_t>(k)] = 1;
+          for (int d = 0; d < 3; ++d) direction[d * n + k] = 0.0;
+        }
+      }
+      if (new_fold) {
+        if (block_rounds < kMaxBlockRounds) {
+          ++block_rounds;  // retry the same step length without the blocked particles
+          slope = q.dot(direction);
+        } else {
+          alpha *= 0.5;
+          ++backtracks;
+        }
+        continue;
+      }
       trial_energies = setup.springs.evaluate(trial_positions, &trial_gradient);
       ++result.evaluations;
       const double energy = energies.total();
       const double trial_energy = trial_energies.total();
-      if (!std::isfinite(trial_energy)) continue;
-      if (trial_energy <= energy + lb.armijo * alpha * slope) {
-        accepted = true;
-      } else if (trial_energy <= energy + 1e-13 * energy) {
-        // Within round-off of the current energy: accept on a smaller tangential gradient.
-        trial_q = layout.tangential(trial_gradient, trial_normals);
-        accepted = trial_q.norm() < q_norm;
+      if (std::isfinite(trial_energy)) {
+        if (trial_energy <= energy + lb.armijo * alpha * slope) {
+          accepted = true;
+        } else if (trial_energy <= energy + 1e-13 * energy) {
+          // Within round-off of the current energy: accept on a smaller tangential gradient.
+          trial_q = layout.tangential(trial_gradient, trial_normals);
+          accepted = trial_q.norm() < q_norm;
+        }
       }
       if (accepted) break;
+      alpha *= 0.5;
+      ++backtracks;
     }
+    last_blocked = block_rounds > 0;
     if (!accepted) {
       if (!memory.empty()) {  // retry from the preconditioned gradient before giving up
         memory.clear();
@@ -235,6 +287,8 @@ RelaxationResult relax_lbfgs(const RelaxationProblem& problem, const RelaxationO
           projected[static_cast<std::size_t>(k)].point;
     folded.swap(trial_folded);
     gradient.swap(trial_gradient);
+    stalled =
+        energies.total() - trial_energies.total() <= 1e-14 * energies.total() ? stalled + 1 : 0;
     energies = trial_energies;
     q = std::move(trial_q);
     q_norm = q.norm();

@@ -8,34 +8,40 @@
 /// Per iteration, with g the spring gradient (3 x #P) and P the projection on the tangent planes at
 /// the interior particles (boundary rows are zero: those particles are fixed):
 /// 1. Tangential gradient q = P g (the force the magnet leaves once particles sit on the surface).
-/// 2. Direction p = -H q by the L-BFGS two-loop recursion over the last `memory` pairs (s, y) (s:
-/// change of
-///    the positions, y: change of P g), with the initial inverse Hessian H0 = L^-1, L the interior
-///    spring Laplacian (solver_common.h: 2C per spring plus the angular springs' Gram matrices),
-///    factorised once with a sparse LDL^T and applied to the x, y and z coordinates. The first step
-///    is therefore the Laplacian solve -L^-1 P g, a Newton step for the springs linearised at rest.
+/// 2. Direction p = -H q by the L-BFGS two-loop recursion over the last `memory` pairs (s, y)
+///    (s: change of the positions, y: change of P g), with the initial inverse Hessian H0 = L^-1,
+///    L the interior spring Laplacian (solver_common.h: 2C per spring plus the angular springs'
+///    Gram matrices), factorised once with a sparse LDL^T and applied to the x, y and z
+///    coordinates. The first step is therefore the Laplacian solve -L^-1 P g, a Newton step for the
+///    springs linearised at rest.
 /// 3. p is projected on the tangent planes again. If it is not a descent direction (P g . p >= 0)
-/// the
-///    memory is cleared and p = -P L^-1 P g is used.
+///    the memory is cleared and p = -P L^-1 P g is used.
 /// 4. Retraction: x_i(alpha) = closest point on the surface to x_i + alpha p_i (the magnet of §4.4,
-/// warm
-///    started from the particle's current surface point).
-/// 5. Backtracking line search from alpha = 1: a trial is rejected when it folds a face corner that
-/// was not
-///    folded (SpringSystem::folded_corners with the new normals), when the energy is not finite, or
-///    when the Armijo condition E(alpha) <= E + c1 alpha (P g . p) fails. Close to the minimum the
-///    energy change can drop below its round-off; a trial whose energy is within 1e-13 E of the
-///    current one is then accepted when its tangential gradient is smaller.
+///    warm started from the particle's current surface point).
+/// 5. Backtracking line search from alpha = 1. A trial that folds a face corner that was not folded
+///    (SpringSystem::folded_corners with the new normals) is never taken: the free particles of the
+///    newly folded corners are *blocked* (their part of p is set to zero, they keep their position
+///    this step) and the same alpha is tried again, up to 8 rounds, after which alpha is halved. A
+///    trial is also rejected (alpha halved) when the energy is not finite or the Armijo condition
+///    E(alpha) <= E + c1 alpha (P g . p) fails. Close to the minimum the energy change can drop
+///    below its round-off; a trial within 1e-13 E of the current energy is then accepted when its
+///    tangential gradient is smaller.
 /// 6. The pair (s, y) is kept when s . y > 1e-12 |s| |y| (curvature condition).
-/// Stopping: see relaxation.h (tangential gradient only). When no trial is accepted with an empty
-/// memory, the solver stops with StopReason::LineSearchFailed.
+///
+/// Stopping: see relaxation.h (tangential gradient only). When particles were blocked in the last
+/// step and the tangential gradient of all the other particles meets the tolerance, the energy
+/// minimum lies beyond the no-fold constraint: the solver stops with StopReason::FoldConstrained
+/// (not converged, no new folds). When no trial is accepted with an empty memory, or 20 steps in a
+/// row change the energy by less than 1e-14 E, it stops with StopReason::LineSearchFailed. Both
+/// happen when the minimum is folded, e.g. a square source region whose 90-degree corners must open
+/// to 180 degrees on a smooth target boundary.
 
 #include "elastic/solvers/relaxation.h"
 
 namespace elastic {
 
-/// Runs the L-BFGS solver (use `relax` with SolverKind::Fast; this is what it calls, in the
-/// caller's arena). \throws as relax.
+/// Runs the L-BFGS solver (`relax` with SolverKind::Fast calls it, in the caller's TBB arena).
+/// \throws as relax.
 RelaxationResult relax_lbfgs(const RelaxationProblem& problem, const RelaxationOptions& options);
 
 }  // namespace elastic

@@ -33,6 +33,8 @@ std::string_view to_string(StopReason reason) {
       return "iteration limit reached";
     case StopReason::LineSearchFailed:
       return "line search found no fold-free decrease";
+    case StopReason::FoldConstrained:
+      return "stopped against the no-fold constraint (the energy minimum folds faces)";
     case StopReason::Diverged:
       return "diverged (non-finite energy or positions)";
     case StopReason::Cancelled:

@@ -7,11 +7,10 @@
 ///
 /// Two solvers, one result (see docs/solvers.md):
 /// - `SolverKind::Fast` (default): tangent-space L-BFGS preconditioned with the prefactored spring
-/// Laplacian,
-///   the magnet (closest point) as the retraction, fold-rejecting Armijo line search
+///   Laplacian, the magnet (closest point) as the retraction, a fold-rejecting Armijo line search
 ///   (lbfgs_solver.h).
 /// - `SolverKind::Faithful`: the paper's damped explicit integrator, eqs. 9-12
-/// (explicit_integrator.h).
+///   (explicit_integrator.h).
 ///
 /// Both stop when the tangential gradient |P g| (the spring gradient projected on the target's
 /// tangent planes at the interior particles) falls below `relative_gradient_tolerance` times its
@@ -51,6 +50,8 @@ enum class StopReason {
   NoFreeParticles,   ///< converged trivially: every particle is on the boundary
   MaxIterations,     ///< not converged: the iteration budget ran out
   LineSearchFailed,  ///< not converged: no fold-free step decreases the energy (L-BFGS)
+  FoldConstrained,   ///< not converged: all particles are at equilibrium except some that are held
+                     ///< back from folding a face (the energy minimum is folded; L-BFGS)
   Diverged,          ///< not converged: the energy or a position became non-finite (explicit)
   Cancelled          ///< not converged: the progress callback asked to stop
 };
@@ -98,8 +99,8 @@ struct RelaxationOptions {
   /// Iteration (L-BFGS) or time-step (explicit) budget; 0: 2,000 for L-BFGS, 200,000 for explicit.
   long max_iterations = 0;
   double relative_gradient_tolerance = 1e-6;  ///< stop when |P g| <= this * initial |P g|
-  double absolute_gradient_tolerance =
-      1e-10;                            ///< ... or |P g| <= this * C_max sigma mean_rest sqrt(#P)
+  /// ... or when |P g| <= this * C_max * sigma * mean_rest * sqrt(#P) (scale-free absolute bound)
+  double absolute_gradient_tolerance = 1e-10;
   int threads = 0;                      ///< TBB threads; 0: all available
   ProgressCallback progress;            ///< called every iteration (L-BFGS) / check (explicit)
   FrameCallback frame;                  ///< called every `frame_interval` iterations
@@ -139,10 +140,10 @@ struct RelaxationResult {
                                 ///< final projection; L-BFGS: 0 (particles stay on the surface)
   double gradient_norm = 0.0;   ///< final |P g|
   double initial_gradient_norm = 0.0;  ///< initial |P g|
-  double relative_gradient =
-      0.0;                       ///< gradient_norm / initial_gradient_norm (0 when the latter is 0)
-  int folded_faces = 0;          ///< faces with a folded corner at the end
-  int initial_folded_faces = 0;  ///< the same at the start
+  /// gradient_norm / initial_gradient_norm (0 when the latter is 0)
+  double relative_gradient = 0.0;
+  int folded_faces = 0;            ///< faces with a folded corner at the end
+  int initial_folded_faces = 0;    ///< the same at the start
   double boundary_residual = 0.0;  ///< max distance of a boundary particle from its target position
   double rest_scale = 1.0;         ///< sigma used
   RestScale rest_scale_mode = RestScale::Boundary;  ///< its mode, as given
@@ -155,9 +156,8 @@ struct RelaxationResult {
 
 /// Relaxes the interior particles of `problem` on the target surface.
 /// \throws InvalidInputError when the problem is inconsistent (sizes, missing grid or target,
-/// non-finite
-///         positions, invalid options); NumericalError when the spring Laplacian cannot be
-///         factorised (an interior component not connected to the boundary).
+///         non-finite positions, invalid options); NumericalError when the spring Laplacian cannot
+///         be factorised (an interior component not connected to the boundary).
 RelaxationResult relax(const RelaxationProblem& problem, const RelaxationOptions& options = {});
 
 }  // namespace elastic

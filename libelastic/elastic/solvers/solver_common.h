@@ -51,8 +51,7 @@ Eigen::SparseMatrix<double> interior_laplacian(const RelaxationSetup& setup,
 
 /// Factorises `laplacian` into `factor` (sparse LDL^T with AMD ordering).
 /// \throws NumericalError when a pivot is not positive: an interior part of the grid is not
-/// connected to the
-///         boundary by springs, so it could drift freely.
+///         connected to the boundary by springs, so it could drift freely.
 void factorize(const Eigen::SparseMatrix<double>& laplacian,
                Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>>& factor);
 
