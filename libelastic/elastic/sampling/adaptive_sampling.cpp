@@ -273,14 +273,23 @@ AdaptiveSamplingResult adaptive_sampling(const ParticleGrid& input, const Region
     accept_moves();
   }
 
+  // The floor's reference: the mean weight over the initial particles. The layout spreads them
+  // evenly over the surface, so this is (close to) the area mean of r over the region, and it stays
+  // fixed while the particles migrate (a mean over the moving particles would grow as they gather
+  // in curved parts and drain the flat parts further).
+  double rbar = 0.0;
+  for (int p = 0; p < np; ++p) rbar += r[p];
+  rbar /= np;
+  const double cap = options.max_weight > 0.0 ? options.max_weight * rbar : 0.0;
+
   for (int it = 0; it < options.max_iterations; ++it) {
-    double rbar = 0.0;
-    for (int p = 0; p < np; ++p) rbar += r[p];
-    rbar /= np;
     // Weights (see the header): all 1 on a flat region, where eq. 8 degenerates to Laplacian
     // smoothing.
     std::vector<double> w(np);
-    for (int p = 0; p < np; ++p) w[p] = rbar > 0.0 ? r[p] + options.floor * rbar : 1.0;
+    for (int p = 0; p < np; ++p) {
+      const double rp = cap > 0.0 ? std::min(r[p], cap) : r[p];
+      w[p] = rbar > 0.0 ? rp + options.floor * rbar : 1.0;
+    }
 
     auto force = [&](int p) {
       Eigen::Vector3d f = Eigen::Vector3d::Zero();
@@ -351,9 +360,9 @@ AdaptiveSamplingResult adaptive_sampling(const ParticleGrid& input, const Region
     for (int p = 0; p < np; ++p) texcoords.at(sp[p], grid.source_uv[p]);
   }
   grid.build_springs();
-  double rbar = 0.0;
-  for (int p = 0; p < np; ++p) rbar += r[p];
-  result.mean_curvature_weight = np > 0 ? rbar / np : 0.0;
+  double rbar_end = 0.0;
+  for (int p = 0; p < np; ++p) rbar_end += r[p];
+  result.mean_curvature_weight = np > 0 ? rbar_end / np : 0.0;
   result.rejected_moves = rejected;
   return result;
 }

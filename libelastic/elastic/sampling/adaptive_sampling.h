@@ -3,15 +3,17 @@
 /// Curvature-adaptive sampling of §4.3 (eqs. 6-8): particles of a laid-out grid migrate, with the
 /// grid's connectivity unchanged, towards where the surface bends.
 ///
-/// Each interior particle i is pulled towards its grid neighbours j (the edges of the grid)
-/// weighted by
+/// Each interior particle i is pulled towards its grid neighbours j (the edges of the grid) with
+/// weights built on the paper's curvature measure r = sqrt((k1^2 + k2^2) / 2) (§4.3):
 ///
-///     w_j = r(x_j) + floor * mean_k r(x_k),    r = sqrt((k1^2 + k2^2) / 2)     (the paper's r,
-///     §4.3)
+///     w_j = min(r(x_j), max_weight * rbar0) + floor * rbar0
 ///
-/// The floor term is ours: with the paper's bare r a flat part (r = 0) exerts no pull and its
-/// particles would all drain into the curved parts; the floor keeps flat parts sampled (density ~ r
-/// + floor * mean r along a line, its square over an area). One Jacobi step moves every particle by
+/// rbar0 is the mean of r over the particles as laid out (evenly spread, so about the area mean of
+/// r over the region), kept fixed while they move. The floor term is ours: with the bare r (floor =
+/// 0) a flat part (r = 0) exerts no pull and its particles drain into the curved parts. In one
+/// dimension the equilibrium spacing is inversely proportional to w, so density contrasts are about
+/// the weight ratio along a line and its square over an area; `max_weight` optionally bounds them.
+/// One Jacobi step moves every particle by
 ///
 ///     dx_i = relaxation * T_i( sum_j w_j (x_j - x_i) / sum_j w_j ),                  (eq. 8)
 ///
@@ -50,9 +52,12 @@
 namespace elastic {
 
 struct AdaptiveSamplingOptions {
-  /// Weight floor as a fraction of the mean curvature weight (see the file comment); 0 is the
-  /// paper's bare weighting. Must be >= 0.
-  double floor = 0.05;
+  /// Weight floor alpha, as a fraction of the mean curvature weight of the initial (evenly spread)
+  /// particles, see the file comment; 0 is the paper's bare weighting. Must be >= 0.
+  double floor = 1.0;
+  /// Curvature weights above max_weight times that mean are clamped to it (0: no clamp). Bounds the
+  /// density contrast near sharp features, where r is huge and would drain everything else.
+  double max_weight = 0.0;
   /// Fraction of the Jacobi displacement applied per iteration, in (0, 1].
   double relaxation = 0.8;
   /// Iteration budget.
