@@ -48,16 +48,22 @@ RelaxationResult relax_explicit(const RelaxationProblem& problem,
 
   // Stable defaults from the interior spring Laplacian (see the header).
   const Eigen::SparseMatrix<double> laplacian = solver_detail::interior_laplacian(setup, options);
+  // Absolute row sums of the symmetric L from its stored lower triangle: an off-diagonal entry
+  // counts in its row and in its column.
+  Eigen::VectorXd row_sums = Eigen::VectorXd::Zero(laplacian.rows());
   double max_diagonal = 0.0;
-  double max_row_sum = 0.0;
   for (Eigen::Index col = 0; col < laplacian.outerSize(); ++col) {
-    double row_sum = 0.0;  // L is symmetric: column sums are row sums
     for (Eigen::SparseMatrix<double>::InnerIterator it(laplacian, col); it; ++it) {
-      row_sum += std::abs(it.value());
-      if (it.row() == col) max_diagonal = std::max(max_diagonal, it.value());
+      row_sums[it.row()] += std::abs(it.value());
+      if (it.row() == col)
+        max_diagonal = std::max(max_diagonal, it.value());
+      else
+        row_sums[col] += std::abs(it.value());
     }
-    max_row_sum = std::max(max_row_sum, row_sum);
   }
+  double max_row_sum = 0.0;
+  for (Eigen::Index k = 0; k < row_sums.size(); ++k)
+    max_row_sum = std::max(max_row_sum, row_sums[k]);
   const double magnet = eo.magnet_stiffness > 0.0 ? eo.magnet_stiffness : max_diagonal;
   const double lambda_max = max_row_sum + magnet;
   const double mass = eo.mass;
@@ -70,7 +76,8 @@ RelaxationResult relax_explicit(const RelaxationProblem& problem,
     // Inverse iteration from the all-ones vector (the slowest Dirichlet mode has one sign).
     Eigen::VectorXd v = Eigen::VectorXd::Ones(laplacian.rows()).normalized();
     for (int it = 0; it < 30; ++it) v = factor.solve(v).normalized();
-    const double lambda_min = v.dot(laplacian * v);  // Rayleigh quotient, |v| = 1
+    // Rayleigh quotient, |v| = 1.
+    const double lambda_min = v.dot(laplacian.selfadjointView<Eigen::Lower>() * v);
     damping = 2.0 * std::sqrt(mass * 0.5 * lambda_min);
   }
   result.time_step = dt;

@@ -4,6 +4,7 @@
 #include <tbb/parallel_for.h>
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <string>
@@ -115,12 +116,20 @@ double tangential_norm(const RelaxationSetup& setup, const Eigen::Matrix3Xd& gra
 Eigen::SparseMatrix<double> interior_laplacian(const RelaxationSetup& setup,
                                                const RelaxationOptions& options) {
   const int n = setup.num_free();
+  // Only the lower triangle is stored (what the LDL^T factorisation reads); the diagonal is summed
+  // densely first, which keeps the triplet list (and its sort) small.
+  Eigen::VectorXd diagonal = Eigen::VectorXd::Zero(n);
   std::vector<Eigen::Triplet<double>> triplets;
-  triplets.reserve(4 * setup.grid.springs.size() + 9 * setup.grid.angular_springs.size());
+  triplets.reserve(setup.grid.springs.size() + 3 * setup.grid.angular_springs.size() +
+                   static_cast<std::size_t>(n));
   const auto add = [&](int p, int q, double value) {
     const int a = setup.interior_index[static_cast<std::size_t>(p)];
     const int b = setup.interior_index[static_cast<std::size_t>(q)];
-    if (a >= 0 && b >= 0) triplets.emplace_back(a, b, value);
+    if (a < 0 || b < 0) return;
+    if (a == b)
+      diagonal[a] += value;
+    else
+      triplets.emplace_back(std::max(a, b), std::min(a, b), value);
   };
   // Normal spring: C (|d| - k)^2 has Hessian 2C d d^T/|d|^2 at rest; the isotropic 2C I per
   // coordinate.
@@ -129,16 +138,19 @@ Eigen::SparseMatrix<double> interior_laplacian(const RelaxationSetup& setup,
     add(s.i, s.i, w);
     add(s.j, s.j, w);
     add(s.i, s.j, -w);
-    add(s.j, s.i, -w);
   }
-  // Angular spring: e = x_i - (x_a + x_b)/2 = v . (x_i, x_a, x_b), Gram matrix 2 C_a v v^T.
-  const double wa = 2.0 * options.angular_stiffness;
-  const double v[3] = {1.0, -0.5, -0.5};
+  // Angular spring: e = x_i - (x_a + x_b)/2 = v . (x_i, x_a, x_b), Gram matrix 2 C_a v v^T with
+  // v = (1, -1/2, -1/2): diagonal (2, 1/2, 1/2) C_a, (i,a) and (i,b) -C_a, (a,b) +C_a/2.
+  const double ca = options.angular_stiffness;
   for (const AngularSpring& s : setup.grid.angular_springs) {
-    const int idx[3] = {s.i, s.a, s.b};
-    for (int r = 0; r < 3; ++r)
-      for (int c = 0; c < 3; ++c) add(idx[r], idx[c], wa * v[r] * v[c]);
+    add(s.i, s.i, 2.0 * ca);
+    add(s.a, s.a, 0.5 * ca);
+    add(s.b, s.b, 0.5 * ca);
+    add(s.i, s.a, -ca);
+    add(s.i, s.b, -ca);
+    add(s.a, s.b, 0.5 * ca);
   }
+  for (int k = 0; k < n; ++k) triplets.emplace_back(k, k, diagonal[k]);
   Eigen::SparseMatrix<double> laplacian(n, n);
   laplacian.setFromTriplets(triplets.begin(), triplets.end());
   return laplacian;

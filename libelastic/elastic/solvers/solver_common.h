@@ -45,7 +45,8 @@ double tangential_norm(const RelaxationSetup& setup, const Eigen::Matrix3Xd& gra
 /// normal spring, and for each angular spring the Gram matrix 2 C_a v v^T with v = (1, -1/2, -1/2)
 /// on (i, a, b), which is the angular energy's Hessian with the unit-direction factor e e^T/|e|^2
 /// replaced by the identity. Rows of boundary particles are dropped (they are fixed: Dirichlet
-/// conditions), their couplings stay on the diagonal.
+/// conditions), their couplings stay on the diagonal. Only the LOWER triangle (diagonal included)
+/// is stored: use selfadjointView<Eigen::Lower>() for products.
 Eigen::SparseMatrix<double> interior_laplacian(const RelaxationSetup& setup,
                                                const RelaxationOptions& options);
 
