@@ -91,7 +91,7 @@ struct Lattice {
 
 // Keeps only the largest edge-connected group of selected cells (ties: the first in scan order).
 bool keep_largest_component(Lattice& L) {
-  const int cx = L.nx - 1, cy = L.ny - 1;
+  const int cx = L.nx - 1;
   std::vector<int> label(L.cells.size(), -1);
   int best_label = -1, best_size = 0, labels = 0;
   for (int start = 0; start < static_cast<int>(L.cells.size()); ++start) {
@@ -127,7 +127,6 @@ bool keep_largest_component(Lattice& L) {
       changed = true;
     }
   }
-  (void)cy;
   return changed;
 }
 
