@@ -230,6 +230,25 @@ TEST(Relaxation, SameInputsGiveTheSameBitsForAnyThreadCount) {
   EXPECT_EQ(a.length_energy, c.length_energy);
 }
 
+TEST(Relaxation, NeverFoldsWhenTheMinimumWouldFold) {
+  // Rest lengths twice the available room (sigma = 2 with the boundary fixed at sigma = 1): the
+  // squeezed sheet lowers its energy by folding, which the fast solver must refuse. Whatever it
+  // reports, no face may fold and it must stop well before its iteration budget.
+  const ParticleGrid grid = test::make_quad_grid(10, 10, 0.1, {-0.5, -0.5});
+  const Target target(test::make_plane_mesh(2, 1.0, Eigen::Isometry3d::Identity()));
+  RelaxationProblem problem =
+      make_problem(grid, target, perturb_interior(grid, test::grid_positions(grid), 0.02, 4));
+  problem.rest_scale = 2.0;
+  RelaxationOptions options;
+  options.max_iterations = 500;
+  const RelaxationResult result = relax(problem, options);
+  EXPECT_EQ(result.initial_folded_faces, 0);
+  EXPECT_EQ(result.folded_faces, 0);
+  EXPECT_LT(result.iterations, 500) << to_string(result.reason);
+  EXPECT_LT(result.length_energy + result.angular_energy, result.initial_energy);
+  expect_boundary_untouched(grid, problem, result);
+}
+
 TEST(Relaxation, StatusFramesAndCancellation) {
   const ParticleGrid grid = test::make_quad_grid(6, 6, 0.2, {-0.6, -0.6});
   const Target target(test::make_plane_mesh(2, 1.0, Eigen::Isometry3d::Identity()));

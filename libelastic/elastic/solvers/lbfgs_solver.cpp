@@ -17,6 +17,8 @@ namespace {
 
 using solver_detail::RelaxationSetup;
 
+// Halvings of a folding step before the folding particles are blocked instead.
+constexpr int kFoldHalvings = 4;
 // Rounds of blocking fold-making particles per line search before the step is halved instead.
 constexpr int kMaxBlockRounds = 8;
 // Consecutive steps without an energy change beyond round-off before the solver gives up.
@@ -120,6 +122,7 @@ RelaxationResult relax_lbfgs(const RelaxationProblem& problem, const RelaxationO
   std::deque<Pair> memory;
   std::vector<char> blocked(static_cast<std::size_t>(n), 0);  // free particles held back this step
   bool last_blocked = false;
+  Eigen::Index blocked_count = 0;
   int stalled = 0;  // consecutive steps that changed the energy by less than its round-off
   std::vector<Eigen::Vector3d> trial_query(static_cast<std::size_t>(n));
   std::vector<SurfacePoint> hints(static_cast<std::size_t>(n));
@@ -145,9 +148,10 @@ RelaxationResult relax_lbfgs(const RelaxationProblem& problem, const RelaxationO
       result.reason = StopReason::AbsoluteGradient;
       break;
     }
-    if (last_blocked) {
-      // Particles were held back from folding a face in the last step. If every other particle is
-      // at equilibrium, the energy minimum lies beyond the no-fold constraint: stop and say so.
+    if (last_blocked && blocked_count <= std::max<Eigen::Index>(1, n / 20)) {
+      // A few particles were held back from folding a face in the last step. If every other
+      // particle is at equilibrium, the energy minimum lies beyond the no-fold constraint: stop and
+      // say so. (With many blocked particles the remaining gradient says little: go on.)
       double free_sum = 0.0;
       for (Eigen::Index k = 0; k < n; ++k)
         if (!blocked[static_cast<std::size_t>(k)]) free_sum += layout.at(q, k).squaredNorm();
@@ -207,7 +211,8 @@ RelaxationResult relax_lbfgs(const RelaxationProblem& problem, const RelaxationO
     SpringEnergies trial_energies;
     Eigen::VectorXd trial_q;
     std::fill(blocked.begin(), blocked.end(), 0);
-    int backtracks = 0, block_rounds = 0;
+    int backtracks = 0, block_rounds = 0, fold_halvings = 0;
+    blocked_count = 0;
     while (backtracks < lb.max_backtracks && slope < 0.0) {
       trial_q.resize(0);
       for (Eigen::Index k = 0; k < n; ++k)
@@ -223,27 +228,31 @@ RelaxationResult relax_lbfgs(const RelaxationProblem& problem, const RelaxationO
         trial_normals.col(p) = projected[static_cast<std::size_t>(k)].normal;
       }
       setup.springs.folded_corners(trial_positions, trial_normals, trial_folded);
+      // A first few folding trials only shorten the step; then the folding particles are blocked.
+      const bool block_now = fold_halvings >= kFoldHalvings && block_rounds < kMaxBlockRounds;
       bool new_fold = false;
       for (std::size_t c = 0; c < folded.size(); ++c) {
         if (!trial_folded[c] || folded[c]) continue;
         new_fold = true;
-        if (block_rounds >= kMaxBlockRounds) break;
+        if (!block_now) break;
         // Block the free particles of the newly folded corner: they keep their position this step.
         const SpringSystem::Corner& corner = setup.springs.corners()[c];
         for (const int p : {corner.i, corner.next, corner.prev}) {
           const int k = setup.interior_index[static_cast<std::size_t>(p)];
           if (k < 0 || blocked[static_cast<std::size_t>(k)]) continue;
           blocked[static_cast<std::size_t>(k)] = 1;
+          ++blocked_count;
           for (int d = 0; d < 3; ++d) direction[d * n + k] = 0.0;
         }
       }
       if (new_fold) {
-        if (block_rounds < kMaxBlockRounds) {
+        if (block_now) {
           ++block_rounds;  // retry the same step length without the blocked particles
           slope = q.dot(direction);
         } else {
           alpha *= 0.5;
           ++backtracks;
+          ++fold_halvings;
         }
         continue;
       }

@@ -19,22 +19,23 @@
 /// 4. Retraction: x_i(alpha) = closest point on the surface to x_i + alpha p_i (the magnet of §4.4,
 ///    warm started from the particle's current surface point).
 /// 5. Backtracking line search from alpha = 1. A trial that folds a face corner that was not folded
-///    (SpringSystem::folded_corners with the new normals) is never taken: the free particles of the
-///    newly folded corners are *blocked* (their part of p is set to zero, they keep their position
-///    this step) and the same alpha is tried again, up to 8 rounds, after which alpha is halved. A
-///    trial is also rejected (alpha halved) when the energy is not finite or the Armijo condition
+///    (SpringSystem::folded_corners with the new normals) is never taken. The first 4 such trials
+///    halve alpha; after that the free particles of the newly folded corners are *blocked* (their
+///    part of p is set to zero, they keep their position this step) and the same alpha is tried
+///    again, up to 8 rounds, after which alpha is halved again. A trial is also rejected (alpha
+///    halved) when the energy is not finite or the Armijo condition
 ///    E(alpha) <= E + c1 alpha (P g . p) fails. Close to the minimum the energy change can drop
 ///    below its round-off; a trial within 1e-13 E of the current energy is then accepted when its
 ///    tangential gradient is smaller.
 /// 6. The pair (s, y) is kept when s . y > 1e-12 |s| |y| (curvature condition).
 ///
-/// Stopping: see relaxation.h (tangential gradient only). When particles were blocked in the last
-/// step and the tangential gradient of all the other particles meets the tolerance, the energy
-/// minimum lies beyond the no-fold constraint: the solver stops with StopReason::FoldConstrained
-/// (not converged, no new folds). When no trial is accepted with an empty memory, or 20 steps in a
-/// row change the energy by less than 1e-14 E, it stops with StopReason::LineSearchFailed. Both
-/// happen when the minimum is folded, e.g. a square source region whose 90-degree corners must open
-/// to 180 degrees on a smooth target boundary.
+/// Stopping: see relaxation.h (tangential gradient only). When a few particles (at most 5%) were
+/// blocked in the last step and the tangential gradient of all the others meets the tolerance, the
+/// energy minimum lies beyond the no-fold constraint: the solver stops with
+/// StopReason::FoldConstrained (not converged, no new folds). When no trial is accepted with an
+/// empty memory, or 20 steps in a row change the energy by less than 1e-14 E, it stops with
+/// StopReason::LineSearchFailed. Both happen when the minimum is folded, e.g. a square source
+/// region whose 90-degree corners must open to 180 degrees on a smooth target boundary.
 
 #include "elastic/solvers/relaxation.h"
 
