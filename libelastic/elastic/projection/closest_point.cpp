@@ -424,6 +424,7 @@ void SurfaceProjector::Impl::check_query(const Eigen::Vector3d& x) const {
 NewtonRun SurfaceProjector::Impl::newton(const Eigen::Vector3d& x, SurfacePoint p) const {
   const LimitSurface& s = *surface;
   const double tolerance = options.parameter_tolerance;
+  const double early_tolerance = 1e-2 * std::sqrt(tolerance);
   NewtonRun run;
   SurfaceDerivatives d = s.derivatives(p);
   Eigen::Vector3d r = d.position - x;
@@ -452,9 +453,11 @@ NewtonRun SurfaceProjector::Impl::newton(const Eigen::Vector3d& x, SurfacePoint 
     // (floored), so a direction of negative curvature is followed downhill with a long step instead
     // of the creeping Gauss-Newton step (J^T J overestimates the curvature there: measured on a
     // torus, GN needed more than 30 iterations from inside the tube where this takes a few).
+    bool pure_newton = false;  // the step below is an exact Newton step (H positive definite)
     auto free_step = [&]() {
       const double det = h00 * h11 - h01 * h01;
       if (h00 > 0.0 && h11 > 0.0 && det > 1e-12 * h00 * h11) {
+        pure_newton = true;
         return Eigen::Vector2d(-(h11 * g.x() - h01 * g.y()) / det,
                                -(h00 * g.y() - h01 * g.x()) / det);
       }
@@ -472,6 +475,7 @@ NewtonRun SurfaceProjector::Impl::newton(const Eigen::Vector3d& x, SurfacePoint 
     auto edge_step = [&](const Eigen::Vector2d& t) {
       const double ht = t.x() * t.x() * h00 + 2.0 * t.x() * t.y() * h01 + t.y() * t.y() * h11;
       const double jt = t.x() * t.x() * g00 + 2.0 * t.x() * t.y() * g01 + t.y() * t.y() * g11;
+      pure_newton = ht > 1e-6 * jt;
       return Eigen::Vector2d(-t.dot(g) / std::max(std::abs(ht), 1e-6 * jt + 1e-300) * t);
     };
     // Steepest descent scaled by the curvature along it (a Cauchy step), used when Newton's step
@@ -557,6 +561,19 @@ NewtonRun SurfaceProjector::Impl::newton(const Eigen::Vector3d& x, SurfacePoint 
       if (run.converged) run.last_step = step;
       break;
     }
+    // A pure Newton step this short ends within ~C |s|^2 (~1e-16 C) of the minimum, and d(p + s) is
+    // d(p) + J s to O(|s|^2): finish() takes it without another evaluation (the last of the ~4 a
+    // warm start costs). Only inside the face (a step off it needs walk()).
+    if (pure_newton && step.norm() <= early_tolerance) {
+      const Eigen::Vector2d uv = p.uv() + step;
+      if (uv.x() >= 0.0 && uv.y() >= 0.0 &&
+          (triangular ? uv.x() + uv.y() <= 1.0 : uv.x() <= 1.0 && uv.y() <= 1.0)) {
+        run.converged = true;
+        run.on_boundary = constrained;
+        run.last_step = step;
+        break;
+      }
+    }
 
     // Backtracking guard on E: accept when E does not grow beyond its own round-off.
     const double slack = 4.0 * std::sqrt(2.0 * energy) * r_noise + 1e-300;
@@ -640,11 +657,10 @@ ClosestPoint SurfaceProjector::Impl::finish(const Eigen::Vector3d& x, const Newt
   ClosestPoint out;
   out.point = run.point;
   out.position = run.d.position;
-  // Newton stopped on a step s below the tolerance without taking it. Taking it costs no
-  // evaluation: d(p + s) = d(p) + J s + O(|s|^2), and |s|^2 < 1e-24 is far below round-off, so the
-  // linearised position is the limit position at p + s. This removes the last ~|J| * tolerance of
-  // error. Only when p + s stays in the face (a step off the domain would need walk() and a new
-  // evaluation).
+  // Newton stopped on a short step s without taking it (below the tolerance, or a pure Newton step
+  // below 1e-2 sqrt(tolerance)). Taking it costs no evaluation: d(p + s) = d(p) + J s + O(|s|^2)
+  // with |s|^2 <= 1e-16 (for the default tolerance), at the level of round-off; likewise the
+  // tangents for the normal. Only when p + s stays in the face (a step off it would need walk()).
   const Eigen::Vector2d uv = run.point.uv() + run.last_step;
   const bool inside = uv.x() >= 0.0 && uv.y() >= 0.0 &&
                       (triangular ? uv.x() + uv.y() <= 1.0 : uv.x() <= 1.0 && uv.y() <= 1.0);
@@ -656,8 +672,13 @@ ClosestPoint SurfaceProjector::Impl::finish(const Eigen::Vector3d& x, const Newt
   out.distance = (x - out.position).norm();
   out.on_boundary = run.on_boundary;
   out.converged = run.converged;
-  Eigen::Vector3d n = run.d.du.cross(run.d.dv);
-  if (!(n.norm() > 1e-12 * run.d.du.norm() * run.d.dv.norm())) {
+  Eigen::Vector3d du = run.d.du, dv = run.d.dv;
+  if (inside) {  // first-order update of the tangents to p + s, for the normal
+    du += run.last_step.x() * run.d.duu + run.last_step.y() * run.d.duv;
+    dv += run.last_step.x() * run.d.duv + run.last_step.y() * run.d.dvv;
+  }
+  Eigen::Vector3d n = du.cross(dv);
+  if (!(n.norm() > 1e-12 * du.norm() * dv.norm())) {
     // Degenerate parametrisation at this point (a collapsed partial derivative at an extraordinary
     // vertex, say): take the normal a hair towards the face centre, where it is regular.
     SurfacePoint q = run.point;
