@@ -1,5 +1,6 @@
 #include "elastic/regions/cut_mesh.h"
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 #include <limits>

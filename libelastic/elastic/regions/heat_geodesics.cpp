@@ -1,5 +1,6 @@
 #include "elastic/regions/heat_geodesics.h"
 
+#include <Eigen/Geometry>
 #include <Eigen/SparseCore>
 #include <algorithm>
 #include <cmath>
@@ -112,9 +113,8 @@ Eigen::VectorXd HeatGeodesics::distance(const MeshLocation& source) const {
       div[v[k]] += 0.5 * (cot_l * (xj - xi).dot(field) + cot_j * (xl - xi).dot(field));
     }
   }
-  // Pin the source triangle's heaviest corner; solve L phi = div on the other vertices (L is
-  // positive semi-definite, so L phi = div X gives phi growing along X: Crane's  Delta phi = div X,
-  // Delta = -L).
+  // Pin the source triangle's heaviest corner; solve Crane's Delta phi = div X on the other
+  // vertices. Our L is positive semi-definite (L = -Delta), so the system is L phi = -div X.
   int kmax = 0;
   source.bary.maxCoeff(&kmax);
   const int pin = tri_[static_cast<size_t>(source.triangle)][kmax];
@@ -137,7 +137,7 @@ Eigen::VectorXd HeatGeodesics::distance(const MeshLocation& source) const {
   a.setFromTriplets(trip.begin(), trip.end());
   Eigen::VectorXd rhs(free);
   for (int i = 0; i < nv; ++i) {
-    if (index[static_cast<size_t>(i)] >= 0) rhs[index[static_cast<size_t>(i)]] = div[i];
+    if (index[static_cast<size_t>(i)] >= 0) rhs[index[static_cast<size_t>(i)]] = -div[i];
   }
   Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver(a);
   if (solver.info() != Eigen::Success) {

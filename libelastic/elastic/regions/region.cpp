@@ -1,5 +1,7 @@
 #include "elastic/regions/region.h"
 
+#include <Eigen/Geometry>
+
 namespace elastic {
 
 SurfaceCurve Region::boundary_curve() const {

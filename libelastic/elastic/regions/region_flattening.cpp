@@ -1,5 +1,6 @@
 #include "elastic/regions/region_flattening.h"
 
+#include <Eigen/Geometry>
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseCore>
 #include <Eigen/SparseLU>

@@ -1,6 +1,7 @@
 #include "elastic/regions/region_spec.h"
 
 #include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 #include <fstream>
@@ -319,6 +320,8 @@ void embed_curve(CutMesh& cut, const std::vector<MeshLocation>& nodes, Chart cha
       seg.back() = n.triangle;  // merged: the next segment runs in this node's triangle
       continue;
     }
+    // The last path may end on the first point (a trace that reaches it within the snap distance).
+    if (i + 1 == nodes.size() && verts.size() > 1 && v == verts.front()) break;
     if (cut.on_curve[static_cast<size_t>(v)]) cut.throw_crossing();
     cut.on_curve[static_cast<size_t>(v)] = 1;
     verts.push_back(v);

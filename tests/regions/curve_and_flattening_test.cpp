@@ -1,0 +1,145 @@
+// SurfaceCurve arithmetic on hand-made polylines, and region flattening (Floater disk map, LSCM).
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <complex>
+#include <memory>
+#include <numbers>
+
+#include "elastic/projection/closest_point.h"
+#include "elastic/regions/region_flattening.h"
+#include "elastic/regions/region_spec.h"
+#include "elastic/shapes/procedural_shapes.h"
+
+namespace elastic {
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+
+/// The square with corners (0,0), (2,0), (2,2), (0,2): perimeter 8.
+SurfaceCurve square() {
+  SurfaceCurve c;
+  c.positions = {{0, 0, 0}, {2, 0, 0}, {2, 2, 0}, {0, 2, 0}};
+  c.points.resize(4);
+  return c;
+}
+
+TEST(SurfaceCurve, LengthAndArcLengths) {
+  const SurfaceCurve c = square();
+  EXPECT_DOUBLE_EQ(c.length(), 8.0);
+  EXPECT_EQ(c.arc_lengths(), (std::vector<double>{0, 2, 4, 6}));
+}
+
+TEST(SurfaceCurve, LocateWrapsAndStartsAtTheAnchor) {
+  SurfaceCurve c = square();
+  auto loc = c.locate(0.3125);  // 2.5 along: segment 1, a quarter in
+  EXPECT_EQ(loc.segment, 1);
+  EXPECT_NEAR(loc.t, 0.25, 1e-15);
+  EXPECT_TRUE(loc.position.isApprox(Eigen::Vector3d(2, 0.5, 0)));
+  loc = c.locate(1.9375);  // wraps to 0.9375: 7.5 along the closing chord
+  EXPECT_EQ(loc.segment, 3);
+  EXPECT_TRUE(loc.position.isApprox(Eigen::Vector3d(0, 0.5, 0)));
+  c.anchor = 0.5;  // s = 0 at (2, 2)
+  EXPECT_TRUE(c.locate(0.0).position.isApprox(Eigen::Vector3d(2, 2, 0)));
+  EXPECT_TRUE(c.locate(0.125).position.isApprox(Eigen::Vector3d(1, 2, 0)));
+}
+
+TEST(SurfaceCurve, NearestArcParameter) {
+  const SurfaceCurve c = square();
+  EXPECT_NEAR(c.nearest_arc_parameter({3, 1, 0}), 3.0 / 8.0, 1e-15);
+  EXPECT_NEAR(c.nearest_arc_parameter({-1, 1.5, 5}), 6.5 / 8.0, 1e-15);
+  // Round trip with locate.
+  for (double s : {0.05, 0.4, 0.77})
+    EXPECT_NEAR(c.nearest_arc_parameter(c.locate(s).position), s, 1e-12);
+}
+
+struct Surface {
+  std::unique_ptr<LimitSurface> surface;
+  std::unique_ptr<SurfaceProjector> projector;
+  explicit Surface(const PolygonMesh& mesh, int res) {
+    surface = std::make_unique<LimitSurface>(mesh);
+    ProjectionOptions o;
+    o.tessellation.resolution = res;
+    projector = std::make_unique<SurfaceProjector>(*surface, o);
+  }
+};
+
+RegionSpec disk(const Eigen::Vector3d& c, double r) {
+  RegionSpec spec;
+  spec.kind = RegionSpec::Kind::Disk;
+  spec.center = c;
+  spec.radius = r;
+  return spec;
+}
+
+TEST(RegionFlattening, DiskMapIsBijectiveWithBoundaryOnTheCircleByArcLength) {
+  const Surface s(make_sphere({.faces = ShapeFaces::Quads, .resolution = 6}), 6);
+  const Region region =
+      make_region(*s.projector, disk(s.projector->closest({0.3, 0.8, 0.5}).position, 0.9));
+  const RegionFlattening flat = flatten_region(region);
+  EXPECT_EQ(flat.method, FlatteningMethod::Disk);
+  EXPECT_EQ(flat.folded_triangles, 0);
+  const SurfaceCurve curve = region.boundary_curve();
+  const auto cum = curve.arc_lengths();
+  for (size_t k = 0; k < region.boundary.size(); ++k) {
+    const Eigen::Vector2d p = flat.uv[static_cast<size_t>(region.boundary[k])];
+    const double angle = 2.0 * kPi * (cum[k] / curve.length() - region.anchor);
+    EXPECT_NEAR(p.x(), std::cos(angle), 1e-12);
+    EXPECT_NEAR(p.y(), std::sin(angle), 1e-12);
+  }
+  // Interior vertices strictly inside the disk.
+  std::vector<char> on_boundary(flat.uv.size(), 0);
+  for (int v : region.boundary) on_boundary[static_cast<size_t>(v)] = 1;
+  for (size_t v = 0; v < flat.uv.size(); ++v) {
+    if (!on_boundary[v]) {
+      EXPECT_LT(flat.uv[v].norm(), 1.0);
+    }
+  }
+}
+
+TEST(RegionFlattening, ConformalMapOfAPlanarRegionIsASimilarity) {
+  const Surface s(make_plane({.faces = ShapeFaces::Quads, .resolution = 6}), 6);
+  const Region region = make_region(*s.projector, disk({0.2, 0.1, 0}, 0.6));
+  const RegionFlattening flat = flatten_region(region, {.method = FlatteningMethod::Conformal});
+  EXPECT_EQ(flat.method, FlatteningMethod::Conformal);
+  EXPECT_EQ(flat.folded_triangles, 0);
+  // Fit uv ~ a z + b over complex numbers (z = x + iy, the region lies in z = 0) by least squares;
+  // a planar region's identity has zero conformal energy, so the residual is solver round-off.
+  using C = std::complex<double>;
+  const auto n = static_cast<double>(region.num_vertices());
+  C mz = 0.0, mw = 0.0;
+  for (int v = 0; v < region.num_vertices(); ++v) {
+    mz += C(region.positions[static_cast<size_t>(v)].x(),
+            region.positions[static_cast<size_t>(v)].y());
+    mw += C(flat.uv[static_cast<size_t>(v)].x(), flat.uv[static_cast<size_t>(v)].y());
+  }
+  mz /= n;
+  mw /= n;
+  C num = 0.0;
+  double den = 0.0;
+  for (int v = 0; v < region.num_vertices(); ++v) {
+    const C z = C(region.positions[static_cast<size_t>(v)].x(),
+                  region.positions[static_cast<size_t>(v)].y()) -
+                mz;
+    const C w = C(flat.uv[static_cast<size_t>(v)].x(), flat.uv[static_cast<size_t>(v)].y()) - mw;
+    num += std::conj(z) * w;
+    den += std::norm(z);
+  }
+  const C a = num / den;
+  double worst = 0.0;
+  for (int v = 0; v < region.num_vertices(); ++v) {
+    const C z = C(region.positions[static_cast<size_t>(v)].x(),
+                  region.positions[static_cast<size_t>(v)].y()) -
+                mz;
+    const C w = C(flat.uv[static_cast<size_t>(v)].x(), flat.uv[static_cast<size_t>(v)].y()) - mw;
+    worst = std::max(worst, std::abs(w - a * z));
+  }
+  EXPECT_LT(worst, 1e-8);
+  // Scaled to the 3D area, orientation preserved: |a| = 1, no reflection (a is a rotation, not
+  // conj).
+  EXPECT_NEAR(std::abs(a), 1.0, 1e-8);
+}
+
+}  // namespace
+}  // namespace elastic
