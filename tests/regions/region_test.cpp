@@ -123,16 +123,18 @@ TEST(DiskRegion, PlaneHasTheAnalyticCircleAndArea) {
   const Region region = make_region(*fx.projector, disk({0.1, -0.05, 0.05}, r));
   expect_consistent(region);
   // Boundary at geodesic (= Euclidean) distance R from the projected centre (0.1, -0.05, 0). The
-  // heat method's distance is O(h) accurate away from the source; we allow 1.5 mean edge lengths.
+  // heat method's distance is O(h) accurate away from the source (measured: at most 0.36 mean edge
+  // lengths h here, 0.8 h on a 4x finer tessellation); we allow 0.75 h.
   const double h = fx.mean_edge();
   const Eigen::Vector3d c(0.1, -0.05, 0.0);
   for (int v : region.boundary) {
     const Eigen::Vector3d& x = region.positions[static_cast<size_t>(v)];
     EXPECT_NEAR(x.z(), 0.0, 1e-12);
-    EXPECT_NEAR((x - c).norm(), r, 1.5 * h);
+    EXPECT_NEAR((x - c).norm(), r, 0.75 * h);
   }
-  // Area of the polygon inside the circle: pi R^2 up to the same radial error, 2 pi R (1.5 h).
-  EXPECT_NEAR(region.area(), kPi * r * r, 2.0 * kPi * r * 1.5 * h);
+  // Area: pi R^2 up to the mean radial error times the perimeter; the mean error is a fraction of
+  // the maximum (measured 0.1 h), allow 2 pi R * h / 4.
+  EXPECT_NEAR(region.area(), kPi * r * r, 2.0 * kPi * r * 0.25 * h);
   EXPECT_GT(projected_winding_area(region, c, Eigen::Vector3d::UnitZ()), 0.0);
 }
 
