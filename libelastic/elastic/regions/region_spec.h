@@ -1,18 +1,26 @@
 #pragma once
 /// \file
-/// Region specifications, as a user gives them on the command line or in the API, and building a Region
-/// from one on a surface:
+/// Region specifications, as a user gives them on the command line or in the API, and building a
+/// Region from one on a surface:
 ///
 ///   disk:X,Y,Z,R     the geodesic disk of radius R around the surface point nearest to (X,Y,Z)
-///   points:FILE      a closed curve through 3+ points (one "x y z" per line), each projected onto the
+///   points:FILE      a closed curve through 3+ points (one "x y z" per line), each projected onto
+///   the
 ///                    surface, joined in order by shortest paths on the surface
 ///   boundary         the surface's own boundary loop (an open surface with exactly one)
-///   uv:FILE          a closed polygon (one "u v" per line) in the texture domain of a mesh with UVs
+///   uv:FILE          a closed polygon (one "u v" per line) in the texture domain of a mesh with
+///   UVs
 ///
 /// The region is the side of the curve that is a disk; when both sides are disks (a closed genus-0
-/// surface) the smaller one by area. Its boundary is oriented counter-clockwise seen from the normal side.
-/// The anchor (start of the boundary correspondence) is the curve point nearest to `anchor` when given;
-/// otherwise it is chosen automatically (see make_region).
+/// surface) the smaller one by area. Its boundary is oriented counter-clockwise seen from the
+/// normal side. Any spec may end with ";anchor=X,Y,Z". The anchor (start of the boundary
+/// correspondence) is the curve point nearest to `anchor` when given; otherwise it is chosen
+/// automatically (see make_region).
+///
+/// The region is cut out of the projector's tessellation along the curve exactly (docs/regions.md):
+/// `disk` distances come from the heat method (Crane et al. 2013), `points` are joined by paths
+/// traced up the heat gradient (approximate geodesics, within about one tessellation edge), `uv`
+/// polygon edges are straight in texture space.
 
 #include <Eigen/Core>
 #include <optional>
@@ -33,8 +41,8 @@ struct RegionSpec {
   double radius = 0.0;                               ///< Disk: geodesic radius
   std::vector<Eigen::Vector3d> points;               ///< Points: the curve's points, in order
   std::vector<Eigen::Vector2d> uv_polygon;           ///< UvPolygon: the polygon in texture space
-  std::optional<Eigen::Vector3d> anchor;             ///< start of the correspondence, if the user gave one
-  std::string text;                                  ///< the spec as written, for messages
+  std::optional<Eigen::Vector3d> anchor;  ///< start of the correspondence, if the user gave one
+  std::string text;                       ///< the spec as written, for messages
 };
 
 /// Parses a spec string. `flag` names where it came from (for messages), e.g. "--source-region".
@@ -42,18 +50,21 @@ struct RegionSpec {
 RegionSpec parse_region_spec(std::string_view text, std::string_view flag = "region");
 
 struct RegionOptions {
-  /// A spec point farther from the surface than this fraction of the surface's bounding-box diagonal is
-  /// an error ("point is far from the surface").
+  /// A spec point farther from the surface than this fraction of the surface's bounding-box
+  /// diagonal is an error ("point is far from the surface").
   double max_point_distance = 0.05;
   /// Name used in error messages, e.g. "--target-region".
   std::string name = "region";
 };
 
-/// Builds the region of `spec` on the projector's surface.
-/// \throws InvalidInputError naming options.name for: a curve that crosses itself, a region that is not
-///         a disk (holds a handle or a hole), a disk that covers a whole closed surface, a point far from
-///         the surface, `boundary` on a surface without exactly one boundary loop, `uv:` on a mesh
-///         without UVs, a degenerate curve (fewer than 3 distinct points, zero length).
+/// Builds the region of `spec` on the projector's surface, boundary counter-clockwise seen from the
+/// normal side. Automatic anchor: the boundary vertex in the direction, from the region's centroid,
+/// of the world axis least aligned with the region's mean normal (x, y, z on ties), projected onto
+/// the plane normal to it. \throws InvalidInputError naming options.name for: a curve that crosses
+/// itself, a region that is not
+///         a disk (holds a handle or a hole), a disk that covers a whole closed surface, a point
+///         far from the surface, `boundary` on a surface without exactly one boundary loop, `uv:`
+///         on a mesh without UVs, a degenerate curve (fewer than 3 distinct points, zero length).
 Region make_region(const SurfaceProjector& projector, const RegionSpec& spec,
                    const RegionOptions& options = {});
 
