@@ -1,6 +1,7 @@
 // OpenMesh's PropertyT<T>::push_back() appends a default-constructed VectorT, whose components are
-// deliberately left uninitialised; with sanitizers GCC 12 reports that as -Wmaybe-uninitialized inside
-// the instantiations this file makes (add_vertex, add_face). The values are overwritten before use.
+// deliberately left uninitialised; with sanitizers GCC 12 reports that as -Wmaybe-uninitialized
+// inside the instantiations this file makes (add_vertex, add_face). The values are overwritten
+// before use.
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
 
 #include "elastic/mesh/openmesh_adapter.h"
