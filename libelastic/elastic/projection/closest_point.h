@@ -3,31 +3,31 @@
 /// The paper's "magnet" (§4.4): the closest point on the limit surface to any 3D point.
 ///
 /// An Embree point query (`rtcPointQuery`) over a dense tessellation of the limit surface finds the
-/// nearest tessellation triangle; the triangle's vertex SurfacePoints give a starting (face, u, v);
-/// Newton iterations on the patch, minimising |d(u,v) - x|^2 and walking across ptex edges when a
-/// step leaves the face (LimitSurface::walk), make the answer exact to round-off. The warm-started
-/// form skips the BVH and starts Newton from a previous SurfacePoint (a particle's last position),
+/// nearest tessellation triangle; the triangle's corners give a starting (face, u, v); Newton
+/// iterations on the patch, minimising |d(u,v) - x|^2 and walking across ptex edges when a step
+/// leaves the face (LimitSurface::walk), make the answer exact to round-off. The warm-started form
+/// skips the BVH and starts Newton from a previous SurfacePoint (a particle's last position),
 /// falling back to the BVH when Newton does not converge near the hint.
 ///
 /// Behaviour at the edges of the problem:
-/// - On an open surface the closest point may lie on the boundary curve; Newton is then constrained
-/// to
-///   the boundary edge and `on_boundary` is set.
-/// - Far from the surface the answer is still the global closest point (the BVH has no radius
-/// limit).
+/// - On an open surface the closest point may lie on the boundary curve; Newton is then
+///   constrained to the boundary edge (1D Newton along it, stopping at a boundary corner) and
+///   `on_boundary` is set.
+/// - Far from the surface the answer is still the global closest point (no radius limit).
 /// - A non-finite query point throws InvalidInputError.
 ///
-/// Seeding: the tessellation triangles' vertices carry SurfacePoints of whichever ptex face they
-/// were welded from; the projector re-expresses each triangle's corners in the triangle's own ptex
-/// face
-/// (`triangle_face`) as nodes of that face's uniform grid, once, at construction, so a seed is the
+/// Seeding: the tessellation's vertices carry the SurfacePoint of whichever ptex face they were
+/// welded from. At construction the projector re-expresses each triangle's corners in the
+/// triangle's own ptex face (`triangle_face`) as nodes of that face's uniform grid (resolution n,
+/// n/2 for the sub-faces of Catmull-Clark n-gons, as tessellate() documents); a corner from another
+/// face is the boundary node of this face with the same limit position. A seed is then the
 /// barycentric blend of three (u, v) in one face.
 ///
 /// Global query: BVH closest triangle -> Newton -> answer at distance D. The limit surface lies
 /// within about `eps` of the tessellation (`eps` estimated at construction from the triangle
 /// centroids), so only triangles closer than D + eps can hide a closer limit point; a second BVH
-/// query collects them and Newton runs from up to `max_global_seeds` of those not next to the
-/// answer. The minimum wins.
+/// query collects them and Newton runs from up to `max_global_seeds` of those not next to an
+/// answer already found. The nearest converged answer wins.
 ///
 /// Warm start: the answer is the local minimum of the distance that Newton reaches from the hint.
 /// It is the global closest point when the query is closer to the surface than the medial axis
@@ -38,8 +38,8 @@
 /// Ownership and threads: a SurfaceProjector keeps a reference to the LimitSurface, which must
 /// outlive it, and owns its tessellation and Embree scene. It can be moved, not copied. All const
 /// queries are thread-safe (Embree point queries on a committed scene are); the batched form runs
-/// on all threads of the TBB arena it is called from. One Embree device is shared by all projectors
-/// of the process; it is created with the first projector and released with the last.
+/// on all threads of the TBB arena it is called from. One Embree device is shared by all
+/// projectors of the process; it is created with the first projector and released with the last.
 
 #include <Eigen/Core>
 #include <memory>
@@ -51,8 +51,7 @@
 namespace elastic {
 
 struct ProjectionOptions {
-  /// Tessellation the BVH is built on (finer gives a better Newton seed, costs memory and build
-  /// time).
+  /// Tessellation the BVH is built on (finer: better seeds, more memory and build time).
   TessellationOptions tessellation{.resolution = 4, .target_triangles = 0};
   /// Newton iterations before giving up on a seed.
   int max_newton_iterations = 30;
@@ -75,7 +74,10 @@ struct ClosestPoint {
   Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();   ///< unit surface normal at point
   double distance = 0.0;                               ///< |query - position|
   bool on_boundary = false;                            ///< the answer lies on the surface boundary
-  bool converged = false;                              ///< Newton reached parameter_tolerance
+  /// Newton converged: its step fell below parameter_tolerance (or a Newton step short enough to
+  /// end within it was taken), the gradient vanished to round-off, or a boundary corner is a
+  /// constrained minimum. False only when every seed ran out of iterations.
+  bool converged = false;
 };
 
 class SurfaceProjector {
@@ -101,9 +103,8 @@ class SurfaceProjector {
   ClosestPoint closest(const Eigen::Vector3d& x, const SurfacePoint& hint) const;
   /// Batched form: out[i] = closest(xs[i]) or closest(xs[i], hints[i]) when `hints` is not empty.
   /// Runs in parallel; gives the same results as the single queries.
-  /// \throws InvalidInputError as the single queries do, or when `out` or a non-empty `hints` does
-  /// not
-  ///         have xs.size() entries.
+  /// \throws InvalidInputError as the single queries do, or when `out` or a non-empty `hints`
+  ///         does not have xs.size() entries.
   void closest(std::span<const Eigen::Vector3d> xs, std::span<ClosestPoint> out,
                std::span<const SurfacePoint> hints = {}) const;
 
