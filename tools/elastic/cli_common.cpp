@@ -16,11 +16,17 @@ bool g_line_open = false;
 }
 
 LoadedSurface load_surface(const std::string& path, const std::string& scheme) {
+  MeshReadResult read = read_mesh(path);
+  LoadedSurface loaded = surface_from_mesh(std::move(read.mesh), path, scheme);
+  loaded.warnings.insert(loaded.warnings.begin(), read.warnings.begin(), read.warnings.end());
+  return loaded;
+}
+
+LoadedSurface surface_from_mesh(PolygonMesh mesh, const std::string& path,
+                                const std::string& scheme) {
   LoadedSurface loaded;
   loaded.path = path;
-  MeshReadResult read = read_mesh(path);
-  loaded.warnings = std::move(read.warnings);
-  loaded.mesh = std::make_unique<PolygonMesh>(std::move(read.mesh));
+  loaded.mesh = std::make_unique<PolygonMesh>(std::move(mesh));
   SanitizeResult sanitized = sanitize_mesh(*loaded.mesh, path);
   loaded.warnings.insert(loaded.warnings.end(), sanitized.warnings.begin(),
                          sanitized.warnings.end());

@@ -26,6 +26,10 @@ struct LoadedSurface {
 /// Reads, sanitises (repairs what is safely repairable, rejects the rest), and builds the limit
 /// surface and the projector. `scheme` is "auto", "loop" or "catmull-clark".
 LoadedSurface load_surface(const std::string& path, const std::string& scheme = "auto");
+/// The same for a mesh made in memory (e.g. the plane carrying a source image); `name` is for
+/// messages.
+LoadedSurface surface_from_mesh(PolygonMesh mesh, const std::string& name,
+                                const std::string& scheme = "auto");
 
 /// A progress callback that redraws one status line on stderr when stderr is a terminal and `quiet`
 /// is false; otherwise an empty callback (nothing goes into pipes or files).

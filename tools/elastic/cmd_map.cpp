@@ -5,6 +5,7 @@
 #include <fstream>
 #include <iostream>
 #include <nlohmann/json.hpp>
+#include <optional>
 
 #include "cli_common.h"
 #include "command.h"
@@ -12,6 +13,7 @@
 #include "elastic/core/error.h"
 #include "elastic/mapping/map_regions.h"
 #include "elastic/mesh/mesh_io.h"
+#include "elastic/regions/image_source.h"
 #include "elastic/regions/region_spec.h"
 
 namespace elastic::cli {
@@ -19,6 +21,8 @@ namespace {
 
 struct MapArgs {
   std::string source, source_region = "boundary", source_anchor;
+  std::string source_image;
+  double image_width = 2.0;
   std::string target, target_region = "boundary", target_anchor;
   long particles = 1000;
   std::string solver = "lbfgs";
@@ -46,7 +50,7 @@ nlohmann::json map_report(const MapArgs& args, const MapResult& r, double total_
   const SamplingStatistics& s = r.sampling.statistics;
   return {{"job",
            {{"command", "map"},
-            {"source", args.source},
+            {"source", args.source.empty() ? args.source_image : args.source},
             {"source_region", args.source_region},
             {"target", args.target},
             {"target_region", args.target_region},
@@ -94,12 +98,34 @@ int run_map(const MapArgs& args) {
     throw InvalidInputError(
         "--particles", "must be between 16 and 5000000, got " + std::to_string(args.particles));
   }
-  const LoadedSurface source = load_surface(args.source, args.scheme);
+  if (args.source.empty() == args.source_image.empty()) {
+    throw InvalidInputError("--source",
+                            "give exactly one of --source MESH and --source-image IMAGE");
+  }
+  // An image source is a plane carrying the image; its region is the rectangle or the inscribed
+  // ellipse.
+  std::optional<ImagePlane> image;
+  if (!args.source_image.empty()) {
+    if (args.source_region != "boundary" && args.source_region != "rectangle" &&
+        args.source_region != "ellipse") {
+      throw InvalidInputError(
+          "--source-region", "with --source-image it is 'rectangle' (default) or 'ellipse', got '" +
+                                 args.source_region + "'");
+    }
+    image = make_image_plane(args.source_image, {.width = args.image_width,
+                                                 .shape = args.source_region == "ellipse"
+                                                              ? ImageRegionShape::Ellipse
+                                                              : ImageRegionShape::Rectangle});
+  }
+  const LoadedSurface source = image
+                                   ? surface_from_mesh(image->mesh, args.source_image, args.scheme)
+                                   : load_surface(args.source, args.scheme);
   print_warnings(source.warnings, args.quiet);
   const LoadedSurface target = load_surface(args.target, args.scheme);
   print_warnings(target.warnings, args.quiet);
 
-  RegionSpec source_spec = parse_region_spec(args.source_region, "--source-region");
+  RegionSpec source_spec =
+      image ? image->region : parse_region_spec(args.source_region, "--source-region");
   if (!args.source_anchor.empty())
     source_spec.anchor = parse_point(args.source_anchor, "--source-anchor");
   RegionSpec target_spec = parse_region_spec(args.target_region, "--target-region");
@@ -156,7 +182,11 @@ int run_map(const MapArgs& args) {
 ELASTIC_COMMAND(
     "map", "Map a source region onto a target region with least distortion", [](CLI::App& sub) {
       auto a = std::make_shared<elastic::cli::MapArgs>();
-      sub.add_option("--source", a->source, "Source mesh file")->required();
+      sub.add_option("--source", a->source, "Source mesh file");
+      sub.add_option("--source-image", a->source_image,
+                     "Source image (PNG, JPEG, ...) on a plane; region: rectangle or ellipse");
+      sub.add_option("--image-width", a->image_width, "Physical width of the source image's plane")
+          ->check(CLI::PositiveNumber);
       sub.add_option("--source-region", a->source_region,
                      "Source region: disk:X,Y,Z,R | points:FILE | boundary | uv:FILE");
       sub.add_option("--source-anchor", a->source_anchor,
