@@ -123,7 +123,7 @@ bool RegionDiskMap::to_disk(const SurfacePoint& p, Eigen::Vector2d& disk) const 
   if (p.face >= 0 && p.face < static_cast<int>(locators_->face_triangles.size())) {
     int best = -1;
     double best_min = -1e-9;  // parameter-space slack for points on triangle edges
-    Eigen::Vector3d best_w;
+    Eigen::Vector3d best_w = Eigen::Vector3d::Zero();
     for (int t : locators_->face_triangles[p.face]) {
       const auto& uv = region.triangle_uv[t];
       const Eigen::Vector3d w = barycentric(uv[0], uv[1], uv[2], p.uv());
@@ -144,10 +144,10 @@ bool RegionDiskMap::to_disk(const SurfacePoint& p, Eigen::Vector2d& disk) const 
   const Eigen::Vector3d x = region.surface->position(p);
   double best_d2 = std::numeric_limits<double>::infinity();
   int best = -1;
-  Eigen::Vector3d best_w;
+  Eigen::Vector3d best_w = Eigen::Vector3d::Zero();
   for (int t = 0; t < region.num_triangles(); ++t) {
     const Eigen::Vector3i& tri = region.triangles[t];
-    Eigen::Vector3d w;
+    Eigen::Vector3d w = Eigen::Vector3d::Zero();
     const double d2 = closest_on_triangle(x, region.positions[tri[0]], region.positions[tri[1]],
                                           region.positions[tri[2]], w);
     if (d2 < best_d2) {

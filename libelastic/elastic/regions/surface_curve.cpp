@@ -25,17 +25,20 @@ std::vector<double> SurfaceCurve::arc_lengths() const {
 }
 
 SurfaceCurve::Location SurfaceCurve::locate(double s) const {
+  return locate(s, arc_lengths(), length());
+}
+
+SurfaceCurve::Location SurfaceCurve::locate(double s, const std::vector<double>& cum,
+                                            double total) const {
   Location loc;
   const int n = size();
   if (n == 0) return loc;
   loc.position = positions.front();
-  const double total = length();
   if (n == 1 || total == 0.0) return loc;
   // Normalised arc length from vertex 0, wrapped into [0, 1).
   double w = anchor + s;
   w -= std::floor(w);
   const double target = w * total;
-  const std::vector<double> cum = arc_lengths();
   // Last vertex whose cumulative length is <= target; the closing chord is segment n-1.
   const auto it = std::upper_bound(cum.begin(), cum.end(), target);
   const int seg = std::max(0, static_cast<int>(it - cum.begin()) - 1);

@@ -12,6 +12,7 @@ namespace elastic {
 BoundarySampler::BoundarySampler(const Region& region, const std::string& name)
     : region_(&region), curve_(region.boundary_curve()) {
   length_ = curve_.length();
+  cumulative_ = curve_.arc_lengths();
   if (!(length_ > 0.0) || !std::isfinite(length_)) {
     throw InvalidInputError(name, "the boundary curve has zero length");
   }
@@ -40,7 +41,7 @@ BoundarySampler::Sample BoundarySampler::at(double s) const {
   Sample out;
   out.s = s - std::floor(s);
   if (out.s >= 1.0) out.s = 0.0;
-  const SurfaceCurve::Location loc = curve_.locate(out.s);
+  const SurfaceCurve::Location loc = curve_.locate(out.s, cumulative_, length_);
   const int n = curve_.size();
   out.segment = loc.segment;
   out.t = loc.t;

@@ -45,6 +45,7 @@ class BoundarySampler {
   const Region* region_;
   SurfaceCurve curve_;
   double length_ = 0.0;
+  std::vector<double> cumulative_;  ///< curve_.arc_lengths(), for O(log N) locate
   /// Per chord k: owning triangle and the corner indices (0..2) of curve vertices k and k+1 in it.
   std::vector<Eigen::Vector3i> chord_triangle_;
 };
