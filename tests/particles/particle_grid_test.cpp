@@ -104,3 +104,30 @@ TEST(ParticleGrid, RestValuesFollowMovedSourcePositions) {
 
 }  // namespace
 }  // namespace elastic
+
+namespace elastic {
+namespace {
+
+// Two quads sharing an edge, with source UVs: the written mesh has the grid's faces in order, the
+// given positions, and per-particle texture coordinates.
+TEST(ParticleGridOutput, PolygonMeshHasTheGridFacesPositionsAndUVs) {
+  ParticleGrid grid;
+  std::vector<GridMesh::VertexHandle> v;
+  for (int k = 0; k < 6; ++k) v.push_back(grid.mesh.add_vertex(GridMesh::Point(k % 3, k / 3, 0)));
+  grid.mesh.add_face(v[0], v[1], v[4], v[3]);
+  grid.mesh.add_face(v[1], v[2], v[5], v[4]);
+  for (int k = 0; k < 6; ++k) grid.source_uv.emplace_back(0.5 * (k % 3), k / 3);
+  Eigen::Matrix3Xd moved = grid.source_positions();
+  moved.row(2).setConstant(7.0);
+  const PolygonMesh mesh = to_polygon_mesh(grid, moved);
+  ASSERT_EQ(mesh.num_faces(), 2);
+  EXPECT_EQ(std::vector<int>(mesh.face(1).begin(), mesh.face(1).end()),
+            (std::vector<int>{1, 2, 5, 4}));
+  EXPECT_EQ(mesh.positions[5], Eigen::Vector3d(2, 1, 7));
+  ASSERT_TRUE(mesh.has_texcoords());
+  EXPECT_EQ(mesh.texcoords[mesh.corner_texcoords[6]],
+            Eigen::Vector2d(1.0, 1.0));  // face 1, corner 2: particle 5
+}
+
+}  // namespace
+}  // namespace elastic

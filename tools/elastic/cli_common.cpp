@@ -71,18 +71,3 @@ void print_warnings(const std::vector<std::string>& warnings, bool quiet) {
 }
 
 }  // namespace elastic::cli
-
-namespace elastic::cli {
-PolygonMesh grid_polygon_mesh(const ParticleGrid& grid, const Eigen::Matrix3Xd& positions) {
-  PolygonMesh mesh;
-  mesh.positions.resize(positions.cols());
-  for (Eigen::Index i = 0; i < positions.cols(); ++i) mesh.positions[i] = positions.col(i);
-  std::vector<int> corners;
-  for (const auto fh : grid.mesh.faces()) {
-    corners.clear();
-    for (const auto vh : grid.mesh.fv_range(fh)) corners.push_back(vh.idx());
-    mesh.add_face(corners);
-  }
-  return mesh;
-}
-}  // namespace elastic::cli

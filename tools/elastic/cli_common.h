@@ -41,13 +41,3 @@ void end_progress_line();
 void print_warnings(const std::vector<std::string>& warnings, bool quiet);
 
 }  // namespace elastic::cli
-
-#include <Eigen/Core>
-
-#include "elastic/particles/particle_grid.h"
-
-namespace elastic::cli {
-/// The particle grid's faces with the given 3 x #P particle positions, as a PolygonMesh for
-/// writing.
-PolygonMesh grid_polygon_mesh(const ParticleGrid& grid, const Eigen::Matrix3Xd& positions);
-}  // namespace elastic::cli

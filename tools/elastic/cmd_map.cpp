@@ -157,9 +157,9 @@ int run_map(const MapArgs& args) {
     const std::filesystem::path dir(args.out);
     std::filesystem::create_directories(dir);
     const ParticleGrid& grid = result.sampling.grid;
-    write_mesh(dir / "source_grid.obj", grid_polygon_mesh(grid, grid.source_positions()));
-    write_mesh(dir / "naive_grid.obj", grid_polygon_mesh(grid, result.naive.positions));
-    write_mesh(dir / "target_grid.obj", grid_polygon_mesh(grid, result.relaxation.positions));
+    write_mesh(dir / "source_grid.obj", to_polygon_mesh(grid, grid.source_positions()));
+    write_mesh(dir / "naive_grid.obj", to_polygon_mesh(grid, result.naive.positions));
+    write_mesh(dir / "target_grid.obj", to_polygon_mesh(grid, result.relaxation.positions));
   }
   if (!args.report.empty()) {
     write_file_atomically(args.report, [&](std::ofstream& out) { out << report.dump(2) << '\n'; });

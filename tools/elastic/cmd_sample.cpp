@@ -33,25 +33,6 @@ struct SampleArgs {
   bool quiet = false;
 };
 
-/// The grid's faces as a PolygonMesh; per-vertex texture coordinates when the particles carry
-/// source UVs.
-PolygonMesh to_polygon_mesh(const ParticleGrid& grid) {
-  PolygonMesh mesh;
-  const Eigen::Matrix3Xd x = grid.source_positions();
-  for (Eigen::Index p = 0; p < x.cols(); ++p) mesh.positions.emplace_back(x.col(p));
-  std::vector<int> corners;
-  for (const auto f : grid.mesh.faces()) {
-    corners.clear();
-    for (const auto v : grid.mesh.fv_range(f)) corners.push_back(v.idx());
-    mesh.add_face(corners);
-  }
-  if (!grid.source_uv.empty()) {
-    mesh.texcoords = grid.source_uv;
-    mesh.corner_texcoords = mesh.face_vertices;  // texcoord index = particle index
-  }
-  return mesh;
-}
-
 int run_sample(const SampleArgs& args) {
   LoadedSurface loaded = load_surface(args.mesh, args.scheme);
   print_warnings(loaded.warnings, args.quiet);
@@ -76,7 +57,8 @@ int run_sample(const SampleArgs& args) {
   const SampleRegionResult sampled = sample_region(region, *loaded.projector, options);
   end_progress_line();
 
-  if (!args.out.empty()) write_mesh(args.out, to_polygon_mesh(sampled.grid));
+  if (!args.out.empty())
+    write_mesh(args.out, to_polygon_mesh(sampled.grid, sampled.grid.source_positions()));
 
   const SamplingStatistics& st = sampled.statistics;
   const nlohmann::json report = {

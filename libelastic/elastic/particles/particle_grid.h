@@ -2,24 +2,26 @@
 /// \file
 /// `ParticleGrid`: the particles and springs of the paper (§4.1, Figs. 1-2) on a source region.
 ///
-/// The grid is an OpenMesh polygon mesh: particles are vertices, *normal springs* are edges, *angular
-/// springs* are face corners. Interior particles form a regular quad grid; boundary particles lie on the
-/// region's boundary curve and are joined to the outside of the quad grid by a band of triangles (no
-/// degenerate or inverted faces). Faces are counter-clockwise seen from the source normal side.
+/// The grid is an OpenMesh polygon mesh: particles are vertices, *normal springs* are edges,
+/// *angular springs* are face corners. Interior particles form a regular quad grid; boundary
+/// particles lie on the region's boundary curve and are joined to the outside of the quad grid by a
+/// band of triangles (no degenerate or inverted faces). Faces are counter-clockwise seen from the
+/// source normal side.
 ///
 /// Rest values are recorded on the source after sampling (§4.2):
 /// - normal spring (i, j): rest length k_ij = |s_j - s_i| (Euclidean source distance, eq. 13);
-/// - angular spring at corner i of a face, between i and the *virtual point* m = (x_a + x_b) / 2, the
+/// - angular spring at corner i of a face, between i and the *virtual point* m = (x_a + x_b) / 2,
+/// the
 ///   midpoint of i's two neighbours a, b in that face: rest length |s_i - m_source| (Fig. 1).
 ///
-/// Flat arrays (`springs`, `angular_springs`) are derived from the mesh by `build_springs()` for the solvers'
-/// inner loops; they stay valid as long as the mesh's connectivity does not change.
-
-#include <OpenMesh/Core/Mesh/PolyMesh_ArrayKernelT.hh>
+/// Flat arrays (`springs`, `angular_springs`) are derived from the mesh by `build_springs()` for
+/// the solvers' inner loops; they stay valid as long as the mesh's connectivity does not change.
 
 #include <Eigen/Core>
+#include <OpenMesh/Core/Mesh/PolyMesh_ArrayKernelT.hh>
 #include <vector>
 
+#include "elastic/mesh/polygon_mesh.h"
 #include "elastic/surface/surface_point.h"
 
 namespace elastic {
@@ -61,7 +63,7 @@ struct ParticleGrid {
   /// (normalised arc length from the anchor, see SurfaceCurve).
   std::vector<double> boundary_parameter;
 
-  std::vector<Spring> springs;                ///< one per mesh edge
+  std::vector<Spring> springs;                 ///< one per mesh edge
   std::vector<AngularSpring> angular_springs;  ///< one per face corner
 
   int num_particles() const { return static_cast<int>(mesh.n_vertices()); }
@@ -71,5 +73,11 @@ struct ParticleGrid {
   /// positions (rest values = current source distances).
   void build_springs();
 };
+
+/// The grid's faces with the given 3 x #P particle positions (e.g. source, naive or relaxed target
+/// positions) as a PolygonMesh for writing; per-vertex texture coordinates are the particles'
+/// source UVs when they carry them, so a written grid shows where every particle came from in the
+/// source texture.
+PolygonMesh to_polygon_mesh(const ParticleGrid& grid, const Eigen::Matrix3Xd& positions);
 
 }  // namespace elastic
