@@ -19,9 +19,14 @@ inline std::filesystem::path shared_mesh(const std::string& name) {
   return std::filesystem::exists(path) ? path : std::filesystem::path();
 }
 
-/// A fresh, empty scratch directory for one test.
+/// A fresh, empty scratch directory for one test. It lives under a folder named after the running test
+/// (CTest runs tests in parallel processes, so tests must never share a scratch folder).
 inline std::filesystem::path scratch_dir(const std::string& name) {
-  const std::filesystem::path dir = std::filesystem::path(ELASTIC_TEST_OUTPUT_DIR) / name;
+  std::filesystem::path dir = std::filesystem::path(ELASTIC_TEST_OUTPUT_DIR);
+  if (const auto* info = ::testing::UnitTest::GetInstance()->current_test_info()) {
+    dir /= std::string(info->test_suite_name()) + "." + info->name();
+  }
+  dir /= name;
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
   return dir;
