@@ -19,8 +19,8 @@ inline std::filesystem::path shared_mesh(const std::string& name) {
   return std::filesystem::exists(path) ? path : std::filesystem::path();
 }
 
-/// A fresh, empty scratch directory for one test. It lives under a folder named after the running test
-/// (CTest runs tests in parallel processes, so tests must never share a scratch folder).
+/// A fresh, empty scratch directory for one test. It lives under a folder named after the running
+/// test (CTest runs tests in parallel processes, so tests must never share a scratch folder).
 inline std::filesystem::path scratch_dir(const std::string& name) {
   std::filesystem::path dir = std::filesystem::path(ELASTIC_TEST_OUTPUT_DIR);
   if (const auto* info = ::testing::UnitTest::GetInstance()->current_test_info()) {
@@ -35,6 +35,6 @@ inline std::filesystem::path scratch_dir(const std::string& name) {
 }  // namespace elastic::test
 
 /// Skips the current test when a shared mesh is missing (../shared is optional for a clone).
-#define ELASTIC_REQUIRE_SHARED_MESH(var, name)                                  \
-  const std::filesystem::path var = ::elastic::test::shared_mesh(name);         \
+#define ELASTIC_REQUIRE_SHARED_MESH(var, name)                          \
+  const std::filesystem::path var = ::elastic::test::shared_mesh(name); \
   if (var.empty()) GTEST_SKIP() << "../shared/meshes/" << (name) << " not present"

@@ -51,8 +51,7 @@ void write_file_atomically(const std::filesystem::path& path,
   if (ec) {
     std::error_code ignored;
     std::filesystem::remove(tmp, ignored);
-    throw IoError(path.string(), "cannot replace file: " + ec.message(),
-                  IoError::Direction::Write);
+    throw IoError(path.string(), "cannot replace file: " + ec.message(), IoError::Direction::Write);
   }
 }
 

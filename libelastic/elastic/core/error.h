@@ -34,8 +34,8 @@ class Error : public std::runtime_error {
   std::string problem_;
 };
 
-/// A file could not be opened, read or written. `direction()` tells which, so a tool can tell a missing
-/// input from an output it cannot create.
+/// A file could not be opened, read or written. `direction()` tells which, so a tool can tell a
+/// missing input from an output it cannot create.
 class IoError : public Error {
  public:
   enum class Direction { Read, Write };

@@ -1,13 +1,13 @@
 #pragma once
 /// \file
-/// `PolygonMesh`: the library's plain indexed polygon mesh, as files hold it. Readers produce it, writers
-/// take it, validation checks it, and `to_openmesh()` (mesh/openmesh_adapter.h) turns a valid one into
-/// halfedge data. Faces may have any number of corners (>= 3); their corners are listed counter-clockwise
-/// seen from the side the surface normal points to.
+/// `PolygonMesh`: the library's plain indexed polygon mesh, as files hold it. Readers produce it,
+/// writers take it, validation checks it, and `to_openmesh()` (mesh/openmesh_adapter.h) turns a
+/// valid one into halfedge data. Faces may have any number of corners (>= 3); their corners are
+/// listed counter-clockwise seen from the side the surface normal points to.
 ///
 /// Storage is "compressed rows": face f has the corners `face_vertices[face_offsets[f] ..
-/// face_offsets[f+1])`. Per-corner attributes (texture coordinates, normals) use the same corner numbering
-/// and index their own pools, as OBJ does, so UV seams are represented exactly.
+/// face_offsets[f+1])`. Per-corner attributes (texture coordinates, normals) use the same corner
+/// numbering and index their own pools, as OBJ does, so UV seams are represented exactly.
 
 #include <Eigen/Core>
 #include <filesystem>
@@ -19,9 +19,10 @@ namespace elastic {
 
 /// A material as an OBJ .mtl file describes it (only what the library uses).
 struct Material {
-  std::string name;                         ///< `newmtl` name
-  Eigen::Vector3d diffuse{0.8, 0.8, 0.8};   ///< `Kd`, linear RGB in [0,1]
-  std::filesystem::path diffuse_texture;    ///< `map_Kd`, resolved relative to the .mtl file; empty if none
+  std::string name;                        ///< `newmtl` name
+  Eigen::Vector3d diffuse{0.8, 0.8, 0.8};  ///< `Kd`, linear RGB in [0,1]
+  std::filesystem::path
+      diffuse_texture;  ///< `map_Kd`, resolved relative to the .mtl file; empty if none
 };
 
 /// A sharp edge for Catmull-Clark/Loop limit surfaces (OBJ `t crease` tags). Sharpness 0 is smooth,
@@ -40,7 +41,8 @@ struct PolygonMesh {
   /// Vertex index of every face corner, faces one after the other.
   std::vector<int> face_vertices;
 
-  /// Texture coordinates (pool) and, for every corner, an index into it. Both empty when the mesh has no UVs.
+  /// Texture coordinates (pool) and, for every corner, an index into it. Both empty when the mesh
+  /// has no UVs.
   std::vector<Eigen::Vector2d> texcoords;
   std::vector<int> corner_texcoords;
   /// Normals (pool) and, for every corner, an index into it. Both empty when the file had none.
@@ -53,12 +55,15 @@ struct PolygonMesh {
   std::vector<Material> materials;
   std::vector<int> face_materials;
 
-  /// Sharp edges (vertex pairs) and sharp corner vertices (vertex, sharpness) read from OBJ `t` tags.
+  /// Sharp edges (vertex pairs) and sharp corner vertices (vertex, sharpness) read from OBJ `t`
+  /// tags.
   std::vector<Crease> creases;
   std::vector<std::pair<int, double>> corners;
 
   int num_vertices() const { return static_cast<int>(positions.size()); }
-  int num_faces() const { return face_offsets.empty() ? 0 : static_cast<int>(face_offsets.size()) - 1; }
+  int num_faces() const {
+    return face_offsets.empty() ? 0 : static_cast<int>(face_offsets.size()) - 1;
+  }
   int face_size(int f) const { return face_offsets[f + 1] - face_offsets[f]; }
   /// The vertex indices of face f, counter-clockwise.
   std::span<const int> face(int f) const {

@@ -1,13 +1,15 @@
 #pragma once
 /// \file
-/// `Region`: a disk-shaped part of a limit surface bounded by one closed curve (§4.1), cut out of the
-/// surface's dense tessellation *along the curve* (the boundary is the curve, not a staircase of edges).
+/// `Region`: a disk-shaped part of a limit surface bounded by one closed curve (§4.1), cut out of
+/// the surface's dense tessellation *along the curve* (the boundary is the curve, not a staircase
+/// of edges).
 ///
-/// The region is a triangle mesh: vertices lie exactly on the limit surface and know their SurfacePoint;
-/// each triangle lies inside one ptex face and knows its corners' (u, v) in that face, so any point of a
-/// triangle maps to a SurfacePoint by barycentric interpolation of (u, v). The boundary loop runs
-/// counter-clockwise seen from the normal side (interior on the left), and its vertices are the
-/// boundary curve's vertices, in order: `boundary_curve()` returns them as a SurfaceCurve.
+/// The region is a triangle mesh: vertices lie exactly on the limit surface and know their
+/// SurfacePoint; each triangle lies inside one ptex face and knows its corners' (u, v) in that
+/// face, so any point of a triangle maps to a SurfacePoint by barycentric interpolation of (u, v).
+/// The boundary loop runs counter-clockwise seen from the normal side (interior on the left), and
+/// its vertices are the boundary curve's vertices, in order: `boundary_curve()` returns them as a
+/// SurfaceCurve.
 ///
 /// A Region does not own its surface: `surface` must outlive it.
 
@@ -23,10 +25,10 @@ namespace elastic {
 struct Region {
   const LimitSurface* surface = nullptr;  ///< the surface the region lies on (not owned)
 
-  std::vector<Eigen::Vector3d> positions;                 ///< #V limit positions
-  std::vector<SurfacePoint> points;                       ///< #V surface points
-  std::vector<Eigen::Vector3i> triangles;                 ///< #T counter-clockwise vertex triples
-  std::vector<int> triangle_face;                         ///< #T ptex face containing each triangle
+  std::vector<Eigen::Vector3d> positions;  ///< #V limit positions
+  std::vector<SurfacePoint> points;        ///< #V surface points
+  std::vector<Eigen::Vector3i> triangles;  ///< #T counter-clockwise vertex triples
+  std::vector<int> triangle_face;          ///< #T ptex face containing each triangle
   std::vector<std::array<Eigen::Vector2d, 3>> triangle_uv;  ///< #T corners' (u,v) in triangle_face
   /// #V texture coordinates interpolated from the control mesh's UVs; empty when it has none.
   std::vector<Eigen::Vector2d> texcoords;

@@ -4,9 +4,11 @@
 /// initial map (both regions mapped to the unit disk and composed, Fig. 9a of the paper), and as a
 /// building block of the baselines.
 ///
-/// - Disk: Floater's mean-value coordinates with the boundary fixed on the unit circle by normalised arc
-///   length starting at the region's anchor (angle 0), counter-clockwise. Bijective for any valid region
-///   (Floater 2003: mean-value weights are positive on a convex boundary), so it never folds.
+/// - Disk: Floater's mean-value coordinates with the boundary fixed on the unit circle by
+/// normalised arc
+///   length starting at the region's anchor (angle 0), counter-clockwise. Bijective for any valid
+///   region (Floater 2003: mean-value weights are positive on a convex boundary), so it never
+///   folds.
 /// - Conformal: least-squares conformal map with a free boundary, scaled to the region's 3D area;
 ///   falls back to Disk if it folds (result says so).
 
@@ -24,9 +26,10 @@ struct FlatteningOptions {
 };
 
 struct RegionFlattening {
-  std::vector<Eigen::Vector2d> uv;  ///< #V planar position of each region vertex
+  std::vector<Eigen::Vector2d> uv;                   ///< #V planar position of each region vertex
   FlatteningMethod method = FlatteningMethod::Disk;  ///< the method actually used
-  int folded_triangles = 0;  ///< triangles with non-positive signed area in the plane (0 when bijective)
+  int folded_triangles =
+      0;  ///< triangles with non-positive signed area in the plane (0 when bijective)
 };
 
 /// \throws NumericalError when the linear system cannot be solved.

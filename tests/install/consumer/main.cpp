@@ -1,5 +1,5 @@
-// A program outside the project that uses the installed library: builds a limit surface of a cube and
-// checks that a face centre lies inside the cube's hull.
+// A program outside the project that uses the installed library: builds a limit surface of a cube
+// and checks that a face centre lies inside the cube's hull.
 #include <elastic/mesh/polygon_mesh.h>
 #include <elastic/surface/limit_surface.h>
 
