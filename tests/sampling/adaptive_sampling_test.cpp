@@ -19,6 +19,8 @@ using test::disk_spec;
 using test::expect_valid_faces;
 using test::make_grid_region;
 using test::make_height_grid;
+using test::polyline_position;
+using test::PolylinePosition;
 
 /// A sharp Gaussian bump z = H exp(-(x^2 + y^2) / w^2) on the square [-1,1]^2, on a fine control
 /// grid.
@@ -104,28 +106,12 @@ TEST(AdaptiveSampling, ParticlesStayOnTheSurfaceAndBoundaryOnTheCurve) {
   }
   // Boundary particles: on the boundary polyline, in cyclic order of their parameters, each at the
   // arc length its parameter says (independent polyline arc length; anchor 0).
-  std::vector<Eigen::Vector3d> poly;
-  for (const int v : bump.region.boundary) poly.push_back(bump.region.positions[v]);
-  const int n = static_cast<int>(poly.size());
-  std::vector<double> cumulative(n + 1, 0.0);
-  for (int k = 0; k < n; ++k)
-    cumulative[k + 1] = cumulative[k] + (poly[(k + 1) % n] - poly[k]).norm();
-  const double length = cumulative[n];
   const int m = static_cast<int>(grid.boundary_loop.size());
   int descents = 0;
   for (int k = 0; k < m; ++k) {
-    const Eigen::Vector3d p = x.col(grid.boundary_loop[k]);
-    int seg = 0;
-    double best = 1e300;
-    for (int e = 0; e < n; ++e) {
-      const Eigen::Vector3d a = poly[e], d = poly[(e + 1) % n] - poly[e];
-      const double t = std::clamp((p - a).dot(d) / d.squaredNorm(), 0.0, 1.0);
-      const double dist = (a + t * d - p).norm();
-      if (dist < best) best = dist, seg = e;
-    }
-    EXPECT_LT(best, 1e-12 * length);
-    const double s = (cumulative[seg] + (p - poly[seg]).norm()) / length;
-    double diff = std::abs(s - grid.boundary_parameter[k]);
+    const PolylinePosition at = polyline_position(bump.region, x.col(grid.boundary_loop[k]));
+    EXPECT_LT(at.distance, 1e-12 * at.length);
+    double diff = std::abs(at.arc - grid.boundary_parameter[k]);
     EXPECT_LT(std::min(diff, 1.0 - diff), 1e-12);
     if (grid.boundary_parameter[(k + 1) % m] < grid.boundary_parameter[k]) ++descents;
   }

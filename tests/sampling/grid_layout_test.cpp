@@ -21,6 +21,8 @@ using test::disk_spec;
 using test::expect_valid_faces;
 using test::make_grid_region;
 using test::make_height_grid;
+using test::polyline_position;
+using test::PolylinePosition;
 
 double flat(double, double) {
   return 0.0;
@@ -110,27 +112,12 @@ TEST(GridLayout, BoundaryParticlesAtEqualArcLength) {
   ASSERT_GE(m, 3);
 
   // Independent arc length: the closed polyline through the region's boundary vertices.
-  std::vector<Eigen::Vector3d> poly;
-  for (const int v : plane.region.boundary) poly.push_back(plane.region.positions[v]);
-  const int n = static_cast<int>(poly.size());
-  std::vector<double> cumulative(n + 1, 0.0);
-  for (int k = 0; k < n; ++k)
-    cumulative[k + 1] = cumulative[k] + (poly[(k + 1) % n] - poly[k]).norm();
-  const double length = cumulative[n];
   const Eigen::Matrix3Xd x = grid.source_positions();
   for (int k = 0; k < m; ++k) {
-    const Eigen::Vector3d p = x.col(grid.boundary_loop[k]);
-    // The segment the particle lies on: the one at the smallest distance.
-    int seg = 0;
-    double best = 1e300;
-    for (int e = 0; e < n; ++e) {
-      const Eigen::Vector3d a = poly[e], d = poly[(e + 1) % n] - poly[e];
-      const double t = std::clamp((p - a).dot(d) / d.squaredNorm(), 0.0, 1.0);
-      const double dist = (a + t * d - p).norm();
-      if (dist < best) best = dist, seg = e;
-    }
-    ASSERT_LT(best, 1e-12 * length);
-    double arc = cumulative[seg] + (p - poly[seg]).norm() - plane.region.anchor * length;
+    const PolylinePosition at = polyline_position(plane.region, x.col(grid.boundary_loop[k]));
+    const double length = at.length;
+    ASSERT_LT(at.distance, 1e-12 * length);
+    double arc = (at.arc - plane.region.anchor) * length;
     arc = std::fmod(arc + 2.0 * length, length);
     double expected = static_cast<double>(k) / m * length;
     double diff = std::abs(arc - expected);

@@ -1,4 +1,7 @@
 #pragma once
+
+#include <algorithm>
+#include <cmath>
 // Test helpers for the sampling tests: a height-field control mesh over [-1,1]^2 and a Region built
 // by hand on its limit surface (independent of regions/make_region), so that the region's
 // triangles, ptex parameters and boundary are known exactly.
@@ -114,6 +117,35 @@ inline std::string disk_spec(const SurfaceProjector& projector, const Eigen::Vec
   out.precision(17);
   out << "disk:" << c.x() << "," << c.y() << "," << c.z() << "," << radius;
   return out.str();
+}
+
+/// Independent arc-length reference for boundary-placement tests: where `p` lies on the closed
+/// polyline through the region's boundary vertices, computed from scratch (no library code).
+struct PolylinePosition {
+  double distance = 0.0;  ///< distance from p to the polyline
+  double arc = 0.0;  ///< normalised arc length from boundary vertex 0 of p's foot point, in [0,1)
+  double length = 0.0;  ///< length of the closed polyline
+};
+inline PolylinePosition polyline_position(const Region& region, const Eigen::Vector3d& p) {
+  std::vector<Eigen::Vector3d> poly;
+  for (const int v : region.boundary) poly.push_back(region.positions[v]);
+  const int n = static_cast<int>(poly.size());
+  std::vector<double> cumulative(n + 1, 0.0);
+  for (int k = 0; k < n; ++k)
+    cumulative[k + 1] = cumulative[k] + (poly[(k + 1) % n] - poly[k]).norm();
+  PolylinePosition out;
+  out.length = cumulative[n];
+  int seg = 0;
+  out.distance = 1e300;
+  for (int e = 0; e < n; ++e) {
+    const Eigen::Vector3d a = poly[e], d = poly[(e + 1) % n] - poly[e];
+    const double t = std::clamp((p - a).dot(d) / d.squaredNorm(), 0.0, 1.0);
+    const double dist = (a + t * d - p).norm();
+    if (dist < out.distance) out.distance = dist, seg = e;
+  }
+  out.arc = (cumulative[seg] + (p - poly[seg]).norm()) / out.length;
+  out.arc -= std::floor(out.arc);
+  return out;
 }
 
 }  // namespace elastic::test
