@@ -24,6 +24,18 @@
 namespace elastic {
 namespace {
 
+// Stores the accumulated parameter derivatives scaled to ptex units: first derivatives by k1,
+// second derivatives by k2 (the chain-rule factors of each patch kind's local parameterisation).
+inline void store_derivatives(SurfaceDerivatives& out, const double du[3], const double dv[3],
+                              const double duu[3], const double duv[3], const double dvv[3],
+                              double k1, double k2) {
+  out.du = {k1 * du[0], k1 * du[1], k1 * du[2]};
+  out.dv = {k1 * dv[0], k1 * dv[1], k1 * dv[2]};
+  out.duu = {k2 * duu[0], k2 * duu[1], k2 * duu[2]};
+  out.duv = {k2 * duv[0], k2 * duv[1], k2 * duv[2]};
+  out.dvv = {k2 * dvv[0], k2 * dvv[1], k2 * dvv[2]};
+}
+
 namespace Far = OpenSubdiv::Far;
 namespace Sdc = OpenSubdiv::Sdc;
 
@@ -826,11 +838,7 @@ void LimitSurface::Impl::evaluate(const SurfacePoint& p, SurfaceDerivatives& out
     out.position = {pos[0], pos[1], pos[2]};
     if constexpr (kDerivatives) {
       const double k1 = rec.scale, k2 = rec.scale * rec.scale;
-      out.du = {k1 * du[0], k1 * du[1], k1 * du[2]};
-      out.dv = {k1 * dv[0], k1 * dv[1], k1 * dv[2]};
-      out.duu = {k2 * duu[0], k2 * duu[1], k2 * duu[2]};
-      out.duv = {k2 * duv[0], k2 * duv[1], k2 * duv[2]};
-      out.dvv = {k2 * dvv[0], k2 * dvv[1], k2 * dvv[2]};
+      store_derivatives(out, du, dv, duu, duv, dvv, k1, k2);
     }
     return;
   }
@@ -866,11 +874,7 @@ void LimitSurface::Impl::evaluate(const SurfacePoint& p, SurfaceDerivatives& out
     out.position = {pos[0], pos[1], pos[2]};
     if constexpr (kDerivatives) {
       const double k1 = sign * rec.scale, k2 = rec.scale * rec.scale;
-      out.du = {k1 * du[0], k1 * du[1], k1 * du[2]};
-      out.dv = {k1 * dv[0], k1 * dv[1], k1 * dv[2]};
-      out.duu = {k2 * duu[0], k2 * duu[1], k2 * duu[2]};
-      out.duv = {k2 * duv[0], k2 * duv[1], k2 * duv[2]};
-      out.dvv = {k2 * dvv[0], k2 * dvv[1], k2 * dvv[2]};
+      store_derivatives(out, du, dv, duu, duv, dvv, k1, k2);
     }
     return;
   }
@@ -906,11 +910,7 @@ void LimitSurface::Impl::evaluate(const SurfacePoint& p, SurfaceDerivatives& out
     // s = c - 2^depth u gives +4^depth. Undo the sign here.
     const double k1 = rec.derivative_fix;
     const double k2 = rec.derivative_fix * rec.derivative_fix * (rec.rotated_triangle ? -1.0 : 1.0);
-    out.du = {k1 * du[0], k1 * du[1], k1 * du[2]};
-    out.dv = {k1 * dv[0], k1 * dv[1], k1 * dv[2]};
-    out.duu = {k2 * duu[0], k2 * duu[1], k2 * duu[2]};
-    out.duv = {k2 * duv[0], k2 * duv[1], k2 * duv[2]};
-    out.dvv = {k2 * dvv[0], k2 * dvv[1], k2 * dvv[2]};
+    store_derivatives(out, du, dv, duu, duv, dvv, k1, k2);
   }
 }
 
