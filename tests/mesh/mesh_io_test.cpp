@@ -176,6 +176,28 @@ TEST(MeshIo, PlyRoundTripAsciiAndBinary) {
   }
 }
 
+TEST(MeshIo, PlyFaceColoursRoundTrip) {
+  // Per-face colours (a heatmap) survive PLY in both encodings; values on the byte grid are exact.
+  const fs::path dir = test::scratch_dir("ply_face_colors");
+  PolygonMesh m = awkward_mesh();
+  for (int f = 0; f < m.num_faces(); ++f) {
+    m.face_colors.emplace_back(static_cast<float>(f) / 255.0f, 1.0f,
+                               static_cast<float>(3 * f) / 255.0f);
+  }
+  for (const bool binary : {false, true}) {
+    SCOPED_TRACE(binary ? "binary" : "ascii");
+    MeshWriteOptions options;
+    options.binary = binary;
+    write_mesh(dir / "p.ply", m, options);
+    const MeshReadResult r = read_mesh(dir / "p.ply");
+    expect_same_geometry(m, r.mesh);
+    EXPECT_EQ(r.mesh.face_colors, m.face_colors);
+  }
+  // A colour array of the wrong size is refused by the writer, naming the problem.
+  m.face_colors.pop_back();
+  EXPECT_THROW(write_mesh(dir / "q.ply", m), InvalidInputError);
+}
+
 TEST(MeshIo, PlyPerVertexAttributes) {
   const fs::path dir = test::scratch_dir("ply_per_vertex");
   PolygonMesh m = awkward_mesh();

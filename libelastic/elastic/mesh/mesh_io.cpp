@@ -74,6 +74,10 @@ void check_writable(const PolygonMesh& mesh, const std::filesystem::path& path) 
   if (!mesh.vertex_colors.empty() && mesh.vertex_colors.size() != mesh.positions.size()) {
     fail("vertex colours: one per vertex expected");
   }
+  if (!mesh.face_colors.empty() &&
+      mesh.face_colors.size() != static_cast<size_t>(mesh.num_faces())) {
+    fail("face colours: one per face expected");
+  }
   if (!mesh.face_materials.empty()) {
     if (mesh.face_materials.size() != static_cast<size_t>(mesh.num_faces())) {
       fail("face materials: one per face expected");

@@ -61,6 +61,9 @@ struct MeshWriteOptions {
   /// Write per-vertex colours when the mesh has them: PLY and OFF (COFF) as 8-bit values, OBJ as
   /// `v x y z r g b`. STL has none.
   bool vertex_colors = true;
+  /// Write per-face colours when the mesh has them: PLY only (face `red green blue` as 8-bit
+  /// values); the other formats have none.
+  bool face_colors = true;
   /// OBJ: also write a .mtl beside the .obj (same stem) for the mesh's materials. Texture paths are
   /// written relative to the .mtl's folder when possible.
   bool write_materials = true;

@@ -415,6 +415,8 @@ void keep_faces(PolygonMesh& mesh, const std::vector<char>& keep) {
   const bool uv = mesh.has_texcoords();
   const bool nrm = mesh.has_normals();
   const bool mat = !mesh.face_materials.empty();
+  const bool col = mesh.has_face_colors();
+  std::vector<Eigen::Vector3f> colors;
   std::vector<int> offsets{0};
   std::vector<int> vertices;
   std::vector<int> uvs;
@@ -431,6 +433,7 @@ void keep_faces(PolygonMesh& mesh, const std::vector<char>& keep) {
     }
     offsets.push_back(static_cast<int>(vertices.size()));
     if (mat) materials.push_back(mesh.face_materials[static_cast<size_t>(f)]);
+    if (col) colors.push_back(mesh.face_colors[static_cast<size_t>(f)]);
   }
   if (offsets.size() == 1) offsets.clear();
   mesh.face_offsets = std::move(offsets);
@@ -438,6 +441,7 @@ void keep_faces(PolygonMesh& mesh, const std::vector<char>& keep) {
   mesh.corner_texcoords = std::move(uvs);
   mesh.corner_normals = std::move(normals);
   mesh.face_materials = std::move(materials);
+  mesh.face_colors = std::move(colors);
 }
 
 /// Reverses face f's orientation, keeping its first corner first (so that a quad's ptex

@@ -4,6 +4,7 @@
 // `texcoord` list.
 
 #include <algorithm>
+#include <array>
 #include <bit>
 #include <cstring>
 #include <unordered_map>
@@ -349,14 +350,31 @@ MeshReadResult read_ply(const std::string& text, const std::filesystem::path& pa
       have_corner_uv = texcoord_property >= 0;
       mesh.face_offsets.reserve(static_cast<size_t>(std::min(element.count, bound)) + 1);
       mesh.face_offsets.push_back(0);
+      // Optional per-face colour (red green blue scalars on the face element).
+      std::array<int, 3> face_color_property{-1, -1, -1};
+      for (size_t p = 0; p < element.properties.size(); ++p) {
+        const PlyProperty& property = element.properties[p];
+        if (property.is_list) continue;
+        if (property.name == "red") face_color_property[0] = static_cast<int>(p);
+        if (property.name == "green") face_color_property[1] = static_cast<int>(p);
+        if (property.name == "blue") face_color_property[2] = static_cast<int>(p);
+      }
+      const bool have_face_color =
+          face_color_property[0] >= 0 && face_color_property[1] >= 0 && face_color_property[2] >= 0;
       std::vector<double> uv_values;
       for (long long row = 0; row < element.count; ++row) {
         data.locate(element.name, row, element.count);
         long long corners = 0;
+        Eigen::Vector3f face_color = Eigen::Vector3f::Zero();
         for (size_t p = 0; p < element.properties.size(); ++p) {
           const PlyProperty& property = element.properties[p];
           if (!property.is_list) {
-            data.read(property.type);
+            const double value = data.read(property.type);
+            for (int k = 0; k < 3; ++k) {
+              if (face_color_property[static_cast<size_t>(k)] == static_cast<int>(p)) {
+                face_color[k] = static_cast<float>(value * color_scale(property.type));
+              }
+            }
             continue;
           }
           const double count = data.read(property.count_type);
@@ -396,6 +414,7 @@ MeshReadResult read_ply(const std::string& text, const std::filesystem::path& pa
             result.mesh.texcoords.emplace_back(uv_values[k], uv_values[k + 1]);
           }
         }
+        if (have_face_color) mesh.face_colors.push_back(face_color);
         mesh.face_offsets.push_back(static_cast<int>(mesh.face_vertices.size()));
       }
       if (mesh.face_offsets.size() == 1) mesh.face_offsets.clear();
@@ -509,6 +528,8 @@ std::string write_ply(const PolygonMesh& mesh, const MeshWriteOptions& options) 
       uv && per_vertex_values(mesh, mesh.texcoords, mesh.corner_texcoords, vertex_uvs);
   const bool corner_uv = uv && !vertex_uv;
   const bool colors = options.vertex_colors && mesh.has_vertex_colors();
+  const bool face_colors = options.face_colors && mesh.has_face_colors() &&
+                           mesh.face_colors.size() == static_cast<size_t>(mesh.num_faces());
   int max_face = 0;
   for (int f = 0; f < mesh.num_faces(); ++f) max_face = std::max(max_face, mesh.face_size(f));
   // List lengths are uchar when they fit, as most readers expect.
@@ -528,6 +549,7 @@ std::string write_ply(const PolygonMesh& mesh, const MeshWriteOptions& options) 
   const char* count_type = byte_counts ? "uchar" : "int";
   out += std::string("property list ") + count_type + " int vertex_indices\n";
   if (corner_uv) out += std::string("property list ") + count_type + " double texcoord\n";
+  if (face_colors) out += "property uchar red\nproperty uchar green\nproperty uchar blue\n";
   out += "end_header\n";
   auto count = [&](int n) {
     if (byte_counts) {
@@ -562,6 +584,9 @@ std::string write_ply(const PolygonMesh& mesh, const MeshWriteOptions& options) 
         w.real(t[0]);
         w.real(t[1]);
       }
+    }
+    if (face_colors) {
+      for (int k = 0; k < 3; ++k) w.byte(to_byte(mesh.face_colors[static_cast<size_t>(f)][k]));
     }
     w.end_row();
   }

@@ -50,6 +50,9 @@ struct PolygonMesh {
   std::vector<int> corner_normals;
   /// Per-vertex RGB colours in [0,1]: empty, or one per vertex.
   std::vector<Eigen::Vector3f> vertex_colors;
+  /// Per-face RGB colours in [0,1]: empty, or one per face (PLY face `red green blue`; e.g. a
+  /// per-triangle distortion heatmap).
+  std::vector<Eigen::Vector3f> face_colors;
 
   /// Materials and, per face, the index of its material (-1 for none). Both may be empty.
   std::vector<Material> materials;
@@ -72,6 +75,7 @@ struct PolygonMesh {
   bool has_texcoords() const { return !corner_texcoords.empty(); }
   bool has_normals() const { return !corner_normals.empty(); }
   bool has_vertex_colors() const { return !vertex_colors.empty(); }
+  bool has_face_colors() const { return !face_colors.empty(); }
   /// True when every face is a triangle (and there is at least one face).
   bool is_triangle_mesh() const;
   /// True when every face is a quadrilateral (and there is at least one face).
