@@ -1,0 +1,126 @@
+#include "elastic/image/image.h"
+
+#include <stb_image.h>
+#include <stb_image_write.h>
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <memory>
+#include <string>
+
+#include "elastic/core/atomic_file.h"
+#include "elastic/core/error.h"
+
+namespace elastic {
+
+Image::Image(int width_, int height_, const Eigen::Vector4f& fill)
+    : width(width_), height(height_) {
+  if (width_ < 0 || height_ < 0) {
+    throw InvalidInputError(
+        "image", "negative size " + std::to_string(width_) + " x " + std::to_string(height_));
+  }
+  pixels.assign(static_cast<size_t>(width_) * static_cast<size_t>(height_), fill);
+}
+
+namespace {
+
+/// Index along one axis after wrapping; `i` may be anywhere.
+int wrap_index(int i, int n, ImageWrap wrap) {
+  if (wrap == ImageWrap::Repeat) {
+    const int r = i % n;
+    return r < 0 ? r + n : r;
+  }
+  return std::clamp(i, 0, n - 1);
+}
+
+}  // namespace
+
+Eigen::Vector4f sample(const Image& image, const Eigen::Vector2d& uv, ImageWrap wrap) {
+  if (image.empty()) return Eigen::Vector4f::Zero();
+  // Continuous pixel coordinates whose integer + 0.5 points are pixel centres (x right, y down).
+  const double x = uv.x() * image.width - 0.5;
+  const double y = (1.0 - uv.y()) * image.height - 0.5;
+  if (!std::isfinite(x) || !std::isfinite(y)) return Eigen::Vector4f::Zero();
+  // Clamp far-away coordinates before the integer conversion (the result is the same).
+  const double xc = std::clamp(x, -4.0 * image.width, 5.0 * image.width);
+  const double yc = std::clamp(y, -4.0 * image.height, 5.0 * image.height);
+  const double fx = std::floor(xc), fy = std::floor(yc);
+  const auto tx = static_cast<float>(xc - fx), ty = static_cast<float>(yc - fy);
+  const int x0 = static_cast<int>(fx), y0 = static_cast<int>(fy);
+  const int xa = wrap_index(x0, image.width, wrap), xb = wrap_index(x0 + 1, image.width, wrap);
+  const int ya = wrap_index(y0, image.height, wrap), yb = wrap_index(y0 + 1, image.height, wrap);
+  const Eigen::Vector4f top = (1.0f - tx) * image.at(xa, ya) + tx * image.at(xb, ya);
+  const Eigen::Vector4f bottom = (1.0f - tx) * image.at(xa, yb) + tx * image.at(xb, yb);
+  return (1.0f - ty) * top + ty * bottom;
+}
+
+Image read_image(const std::filesystem::path& path) {
+  const std::string name = path.string();
+  if (!std::ifstream(path, std::ios::binary)) throw IoError(name, "cannot open the image");
+  int columns = 0, rows = 0, channels = 0;
+  if (!stbi_info(name.c_str(), &columns, &rows, &channels) || columns <= 0 || rows <= 0) {
+    throw InvalidInputError(name,
+                            std::string("not a readable image (") + stbi_failure_reason() + ")");
+  }
+  constexpr int kMaxSide = 32768;
+  if (columns > kMaxSide || rows > kMaxSide) {
+    throw InvalidInputError(name, "image of " + std::to_string(columns) + " x " +
+                                      std::to_string(rows) + " pixels is larger than " +
+                                      std::to_string(kMaxSide) + " on a side");
+  }
+  const std::unique_ptr<stbi_uc, void (*)(void*)> data(
+      stbi_load(name.c_str(), &columns, &rows, &channels, 4), stbi_image_free);
+  if (!data) {
+    throw InvalidInputError(name,
+                            std::string("not a readable image (") + stbi_failure_reason() + ")");
+  }
+  Image image(columns, rows);
+  const stbi_uc* p = data.get();
+  for (Eigen::Vector4f& pixel : image.pixels) {
+    for (int k = 0; k < 4; ++k) pixel[k] = static_cast<float>(*p++) / 255.0f;
+  }
+  return image;
+}
+
+void write_png(const std::filesystem::path& path, const Image& image) {
+  const std::string name = path.string();
+  if (image.empty() || image.width <= 0 || image.height <= 0) {
+    throw InvalidInputError(name, "cannot write an empty image");
+  }
+  bool opaque = true;
+  for (size_t i = 0; i < image.pixels.size(); ++i) {
+    if (!image.pixels[i].allFinite()) {
+      throw InvalidInputError(
+          name, "pixel " + std::to_string(i % static_cast<size_t>(image.width)) + "," +
+                    std::to_string(i / static_cast<size_t>(image.width)) + " is not finite");
+    }
+    if (image.pixels[i][3] < 1.0f) opaque = false;
+  }
+  const int channels = opaque ? 3 : 4;
+  std::vector<unsigned char> bytes;
+  bytes.reserve(image.pixels.size() * static_cast<size_t>(channels));
+  for (const Eigen::Vector4f& pixel : image.pixels) {
+    for (int k = 0; k < channels; ++k) {
+      bytes.push_back(
+          static_cast<unsigned char>(std::lround(std::clamp(pixel[k], 0.0f, 1.0f) * 255.0f)));
+    }
+  }
+  // stb encodes through a callback; collect the PNG in memory, then write it atomically.
+  std::string png;
+  const auto append = [](void* context, void* data, int size) {
+    static_cast<std::string*>(context)->append(static_cast<const char*>(data),
+                                               static_cast<size_t>(size));
+  };
+  if (!stbi_write_png_to_func(append, &png, image.width, image.height, channels, bytes.data(),
+                              image.width * channels) ||
+      png.empty()) {
+    throw IoError(name, "PNG encoding failed", IoError::Direction::Write);
+  }
+  write_file_atomically(
+      path,
+      [&](std::ofstream& out) { out.write(png.data(), static_cast<std::streamsize>(png.size())); },
+      true);
+}
+
+}  // namespace elastic
