@@ -1,0 +1,380 @@
+#include "elastic/transfer/target_samples.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <numeric>
+#include <optional>
+#include <utility>
+
+#include "elastic/core/error.h"
+#include "elastic/surface/limit_surface.h"
+
+namespace elastic {
+namespace {
+
+using EdgeKey = std::pair<int, int>;
+EdgeKey key(int a, int b) {
+  return {std::min(a, b), std::max(a, b)};
+}
+
+// Position of a boundary vertex along the region's boundary loop: lambda = k + t for the point at
+// fraction t (in the ptex chart) of the loop's segment k (from boundary[k] to boundary[k+1]); -1
+// for interior vertices. Midpoints of boundary edges are halfway in lambda, which is halfway in
+// (u, v) along the segment, i.e. the same point the 1-to-4 split creates.
+double midpoint_lambda(double a, double b, int loop_size) {
+  // a -> b follows the loop (boundary edges of counter-clockwise triangles run along it); b may
+  // have wrapped past the loop's start.
+  if (b <= a) b += loop_size;
+  const double m = 0.5 * (a + b);
+  return m >= loop_size ? m - loop_size : m;
+}
+
+// For each directed boundary segment k (boundary[k] -> boundary[k+1]) of a region, the triangle
+// holding it, so that a point at fraction t of the segment gets (u, v) in that triangle's face.
+std::vector<int> boundary_segment_triangles(const Region& region) {
+  const int n = static_cast<int>(region.boundary.size());
+  std::map<EdgeKey, int> directed;  // (from, to) -> triangle
+  for (int t = 0; t < region.num_triangles(); ++t) {
+    const Eigen::Vector3i& tri = region.triangles[static_cast<size_t>(t)];
+    for (int k = 0; k < 3; ++k) directed[{tri[k], tri[(k + 1) % 3]}] = t;
+  }
+  std::vector<int> out(static_cast<size_t>(n), -1);
+  for (int k = 0; k < n; ++k) {
+    const int a = region.boundary[static_cast<size_t>(k)];
+    const int b = region.boundary[static_cast<size_t>((k + 1) % n)];
+    const auto it = directed.find({a, b});
+    if (it != directed.end()) out[static_cast<size_t>(k)] = it->second;
+  }
+  return out;
+}
+
+// The (u, v) of region vertex v as a corner of triangle t.
+Eigen::Vector2d corner_uv(const Region& region, int t, int v) {
+  const Eigen::Vector3i& tri = region.triangles[static_cast<size_t>(t)];
+  for (int k = 0; k < 3; ++k) {
+    if (tri[k] == v) return region.triangle_uv[static_cast<size_t>(t)][static_cast<size_t>(k)];
+  }
+  return region.points[static_cast<size_t>(v)].uv();
+}
+
+// The point of a region's boundary at correspondence parameter s, exactly on the limit surface:
+// the curve's chord segment and fraction from SurfaceCurve::locate, put into (u, v) of the face of
+// the triangle holding the segment (the curve is straight in (u, v) there).
+struct CurveOnSurface {
+  const Region* region = nullptr;
+  SurfaceCurve curve;
+  std::vector<double> cumulative;
+  double total = 0.0;
+  std::vector<int> segment_triangle;
+
+  explicit CurveOnSurface(const Region& r)
+      : region(&r),
+        curve(r.boundary_curve()),
+        cumulative(curve.arc_lengths()),
+        total(curve.length()),
+        segment_triangle(boundary_segment_triangles(r)) {}
+
+  SurfacePoint at(double s) const {
+    const SurfaceCurve::Location loc = curve.locate(s, cumulative, total);
+    const int n = curve.size();
+    const int a = region->boundary[static_cast<size_t>(loc.segment)];
+    const int b = region->boundary[static_cast<size_t>((loc.segment + 1) % n)];
+    const int t = segment_triangle[static_cast<size_t>(loc.segment)];
+    if (t < 0)
+      return loc.t < 0.5 ? region->points[static_cast<size_t>(a)]
+                         : region->points[static_cast<size_t>(b)];
+    const Eigen::Vector2d uv =
+        (1.0 - loc.t) * corner_uv(*region, t, a) + loc.t * corner_uv(*region, t, b);
+    return SurfacePoint{region->triangle_face[static_cast<size_t>(t)], uv.x(), uv.y()};
+  }
+
+  // Correspondence parameter of loop position lambda (segment + fraction along its chord).
+  double parameter(double lambda) const {
+    const int n = curve.size();
+    int k = static_cast<int>(std::floor(lambda));
+    k = std::clamp(k, 0, n - 1);
+    const double f = lambda - k;
+    const double len = (curve.positions[static_cast<size_t>((k + 1) % n)] -
+                        curve.positions[static_cast<size_t>(k)])
+                           .norm();
+    double s = (cumulative[static_cast<size_t>(k)] + f * len) / total - curve.anchor;
+    s -= std::floor(s);
+    return s;
+  }
+};
+
+// Mesh under refinement.
+struct Work {
+  std::vector<SurfacePoint> points;
+  std::vector<double> lambda;  // loop position, -1 inside
+  std::vector<Eigen::Vector3i> triangles;
+  std::vector<int> face;
+  std::vector<std::array<Eigen::Vector2d, 3>> uv;
+  std::vector<int> parent;
+};
+
+// One 1-to-4 split of every triangle at its edge midpoints in (u, v). A midpoint shared by two
+// triangles of different ptex faces is created once (from the first triangle that meets the edge);
+// both (face, u, v) denote the same limit point.
+void split_all(Work& w, int loop_size) {
+  std::map<EdgeKey, int> edge_count;
+  for (const Eigen::Vector3i& t : w.triangles) {
+    for (int k = 0; k < 3; ++k) ++edge_count[key(t[k], t[(k + 1) % 3])];
+  }
+  std::map<EdgeKey, int> midpoint;
+  std::vector<Eigen::Vector3i> triangles;
+  std::vector<int> face, parent;
+  std::vector<std::array<Eigen::Vector2d, 3>> uv;
+  triangles.reserve(w.triangles.size() * 4);
+  face.reserve(w.triangles.size() * 4);
+  parent.reserve(w.triangles.size() * 4);
+  uv.reserve(w.triangles.size() * 4);
+  for (size_t t = 0; t < w.triangles.size(); ++t) {
+    const Eigen::Vector3i& c = w.triangles[t];
+    const auto& cuv = w.uv[t];
+    std::array<int, 3> m{};
+    std::array<Eigen::Vector2d, 3> muv;
+    for (int k = 0; k < 3; ++k) {
+      const int a = c[k], b = c[(k + 1) % 3];
+      muv[static_cast<size_t>(k)] =
+          0.5 * (cuv[static_cast<size_t>(k)] + cuv[static_cast<size_t>((k + 1) % 3)]);
+      const auto [it, fresh] = midpoint.try_emplace(key(a, b), static_cast<int>(w.points.size()));
+      m[static_cast<size_t>(k)] = it->second;
+      if (!fresh) continue;
+      w.points.push_back(SurfacePoint{w.face[t], muv[static_cast<size_t>(k)].x(),
+                                      muv[static_cast<size_t>(k)].y()});
+      const double la = w.lambda[static_cast<size_t>(a)], lb = w.lambda[static_cast<size_t>(b)];
+      const bool boundary_edge = edge_count[key(a, b)] == 1 && la >= 0.0 && lb >= 0.0;
+      w.lambda.push_back(boundary_edge ? midpoint_lambda(la, lb, loop_size) : -1.0);
+    }
+    const auto add = [&](int a, int b, int d, const Eigen::Vector2d& ua, const Eigen::Vector2d& ub,
+                         const Eigen::Vector2d& ud) {
+      triangles.emplace_back(a, b, d);
+      face.push_back(w.face[t]);
+      parent.push_back(w.parent[t]);
+      uv.push_back({ua, ub, ud});
+    };
+    // Corner k keeps the midpoints of its two edges: (c_k, m_k, m_{k-1}); the middle triangle is
+    // (m_0, m_1, m_2). All four keep the parent's orientation.
+    add(c[0], m[0], m[2], cuv[0], muv[0], muv[2]);
+    add(c[1], m[1], m[0], cuv[1], muv[1], muv[0]);
+    add(c[2], m[2], m[1], cuv[2], muv[2], muv[1]);
+    add(m[0], m[1], m[2], muv[0], muv[1], muv[2]);
+  }
+  w.triangles = std::move(triangles);
+  w.face = std::move(face);
+  w.parent = std::move(parent);
+  w.uv = std::move(uv);
+}
+
+double longest_edge(const std::vector<Eigen::Vector3d>& x, const Eigen::Vector3i& t) {
+  return std::max({(x[static_cast<size_t>(t[1])] - x[static_cast<size_t>(t[0])]).norm(),
+                   (x[static_cast<size_t>(t[2])] - x[static_cast<size_t>(t[1])]).norm(),
+                   (x[static_cast<size_t>(t[0])] - x[static_cast<size_t>(t[2])]).norm()});
+}
+
+// Levels needed to bring `length` down to `limit` by halving.
+int levels_for(double length, double limit) {
+  if (!(limit > 0.0) || length <= limit) return 0;
+  return static_cast<int>(std::ceil(std::log2(length / limit) - 1e-12));
+}
+
+}  // namespace
+
+TargetSamples sample_target(const Region& region, const Mapping& mapping,
+                            const TargetSamplingOptions& options) {
+  const std::string& name = options.name;
+  if (region.surface == nullptr || region.num_triangles() == 0) {
+    throw InvalidInputError(name, "the target region is empty");
+  }
+  if (!(options.max_edge >= 0.0) || !(options.max_source_edge >= 0.0) ||
+      !std::isfinite(options.max_edge) || !std::isfinite(options.max_source_edge)) {
+    throw InvalidInputError(name, "max_edge and max_source_edge must be finite and >= 0");
+  }
+  if (options.max_levels < 0 || options.max_levels > 12) {
+    throw InvalidInputError(
+        name, "max_levels " + std::to_string(options.max_levels) + " is outside 0..12");
+  }
+  const LimitSurface& surface = *region.surface;
+  const int loop_size = static_cast<int>(region.boundary.size());
+
+  Work w;
+  w.points = region.points;
+  w.lambda.assign(region.points.size(), -1.0);
+  for (int k = 0; k < loop_size; ++k) {
+    w.lambda[static_cast<size_t>(region.boundary[static_cast<size_t>(k)])] = k;
+  }
+  w.triangles = region.triangles;
+  w.face = region.triangle_face;
+  w.uv = region.triangle_uv;
+  w.parent.resize(region.triangles.size());
+  std::iota(w.parent.begin(), w.parent.end(), 0);
+
+  // Levels: from the coarse triangles' 3D edges and (when asked) their images on the source.
+  int levels = 0;
+  for (const Eigen::Vector3i& t : region.triangles) {
+    levels = std::max(levels, levels_for(longest_edge(region.positions, t), options.max_edge));
+  }
+  if (options.max_source_edge > 0.0) {
+    std::vector<Eigen::Vector3d> source(region.points.size(), Eigen::Vector3d::Zero());
+    std::vector<char> has(region.points.size(), 0);
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, region.points.size()),
+                      [&](const tbb::blocked_range<size_t>& r) {
+                        for (size_t i = r.begin(); i != r.end(); ++i) {
+                          const Mapping::Location loc = mapping.inverse(region.points[i]);
+                          has[i] = loc.inside;
+                          source[i] = loc.position;
+                        }
+                      });
+    for (const Eigen::Vector3i& t : region.triangles) {
+      if (!has[static_cast<size_t>(t[0])] || !has[static_cast<size_t>(t[1])] ||
+          !has[static_cast<size_t>(t[2])])
+        continue;
+      levels = std::max(levels, levels_for(longest_edge(source, t), options.max_source_edge));
+    }
+  }
+  TargetSamples out;
+  if (levels > options.max_levels) {
+    levels = options.max_levels;
+    out.limited = true;
+  }
+  // Vertex count after each level: V' = V + E, E' = 2E + 3T, T' = 4T (Euler on the disk).
+  {
+    long v = static_cast<long>(region.points.size());
+    long t = region.num_triangles();
+    long e = (3 * t + loop_size) / 2;
+    for (int l = 0; l < levels; ++l) {
+      if (v + e > options.max_vertices) {
+        levels = l;
+        out.limited = true;
+        break;
+      }
+      v += e;
+      e = 2 * e + 3 * t;
+      t *= 4;
+    }
+  }
+  for (int l = 0; l < levels; ++l) split_all(w, loop_size);
+  out.levels = levels;
+
+  const size_t nv = w.points.size();
+  out.points = std::move(w.points);
+  out.positions.resize(nv);
+  out.normals.resize(nv);
+  out.sources.resize(nv);
+  out.on_boundary.resize(nv);
+  for (size_t i = 0; i < nv; ++i) out.on_boundary[i] = w.lambda[i] >= 0.0;
+
+  std::optional<CurveOnSurface> target_curve, source_curve;
+  if (options.source_region != nullptr && loop_size >= 3 &&
+      options.source_region->boundary.size() >= 3) {
+    target_curve.emplace(region);
+    source_curve.emplace(*options.source_region);
+  }
+  const LimitSurface* source_surface =
+      options.source_region != nullptr ? options.source_region->surface : nullptr;
+
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, nv), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t i = r.begin(); i != r.end(); ++i) {
+      const SurfacePoint& p = out.points[i];
+      out.positions[i] = surface.position(p);
+      out.normals[i] = surface.curvature(p).normal;
+      if (out.on_boundary[i] && source_curve && source_surface != nullptr) {
+        // The boundary correspondence of §4.1: same normalised arc length from the anchors.
+        Mapping::Location loc;
+        loc.inside = true;
+        loc.point = source_curve->at(target_curve->parameter(w.lambda[i]));
+        loc.position = source_surface->position(loc.point);
+        out.sources[i] = loc;
+      } else {
+        out.sources[i] = mapping.inverse(p);
+      }
+    }
+  });
+  if (source_curve) {
+    for (size_t i = 0; i < nv; ++i) out.boundary_by_arc_length += out.on_boundary[i] ? 1 : 0;
+  }
+
+  // Interior vertices the grid does not cover: nudge towards an adjacent triangle's centroid.
+  std::vector<std::vector<int>> vertex_triangles(nv);
+  for (size_t t = 0; t < w.triangles.size(); ++t) {
+    for (int k = 0; k < 3; ++k) {
+      vertex_triangles[static_cast<size_t>(w.triangles[t][k])].push_back(static_cast<int>(t));
+    }
+  }
+  for (size_t i = 0; i < nv; ++i) {
+    if (out.sources[i].inside) continue;
+    bool found = false;
+    for (const double f : {0.1, 0.25, 0.5}) {
+      for (int t : vertex_triangles[i]) {
+        const auto& uv = w.uv[static_cast<size_t>(t)];
+        const Eigen::Vector3i& tri = w.triangles[static_cast<size_t>(t)];
+        Eigen::Vector2d own = uv[0];
+        for (int k = 0; k < 3; ++k) {
+          if (static_cast<size_t>(tri[k]) == i) own = uv[static_cast<size_t>(k)];
+        }
+        const Eigen::Vector2d centroid = (uv[0] + uv[1] + uv[2]) / 3.0;
+        const Eigen::Vector2d q = (1.0 - f) * own + f * centroid;
+        const Mapping::Location loc =
+            mapping.inverse(SurfacePoint{w.face[static_cast<size_t>(t)], q.x(), q.y()});
+        if (loc.inside) {
+          out.sources[i] = loc;
+          found = true;
+          break;
+        }
+      }
+      if (found) break;
+    }
+    if (found)
+      ++out.nudged;
+    else
+      ++out.unresolved;
+  }
+
+  // Boundary loop of the refined mesh: boundary vertices in loop order.
+  std::vector<std::pair<double, int>> loop;
+  for (size_t i = 0; i < nv; ++i) {
+    if (w.lambda[i] >= 0.0) loop.emplace_back(w.lambda[i], static_cast<int>(i));
+  }
+  std::sort(loop.begin(), loop.end());
+  out.boundary.reserve(loop.size());
+  for (const auto& entry : loop) out.boundary.push_back(entry.second);
+
+  out.triangles = std::move(w.triangles);
+  out.triangle_face = std::move(w.face);
+  out.triangle_uv = std::move(w.uv);
+  out.triangle_parent = std::move(w.parent);
+  std::vector<Eigen::Vector3d> source_positions(nv);
+  for (size_t i = 0; i < nv; ++i) source_positions[i] = out.sources[i].position;
+  for (const Eigen::Vector3i& t : out.triangles) {
+    out.max_edge_length = std::max(out.max_edge_length, longest_edge(out.positions, t));
+    if (out.sources[static_cast<size_t>(t[0])].inside &&
+        out.sources[static_cast<size_t>(t[1])].inside &&
+        out.sources[static_cast<size_t>(t[2])].inside) {
+      out.max_source_edge_length =
+          std::max(out.max_source_edge_length, longest_edge(source_positions, t));
+    }
+  }
+  return out;
+}
+
+double source_texel_length(const Region& region, int columns, int rows) {
+  if (region.texcoords.size() != region.positions.size() || columns <= 0 || rows <= 0) return 0.0;
+  double texture_area = 0.0;
+  for (const Eigen::Vector3i& t : region.triangles) {
+    const Eigen::Vector2d& a = region.texcoords[static_cast<size_t>(t[0])];
+    const Eigen::Vector2d e1 = region.texcoords[static_cast<size_t>(t[1])] - a;
+    const Eigen::Vector2d e2 = region.texcoords[static_cast<size_t>(t[2])] - a;
+    texture_area += 0.5 * std::abs(e1.x() * e2.y() - e1.y() * e2.x());
+  }
+  const double texels = texture_area * static_cast<double>(columns) * static_cast<double>(rows);
+  if (!(texels > 0.0)) return 0.0;
+  return std::sqrt(region.area() / texels);
+}
+
+}  // namespace elastic
