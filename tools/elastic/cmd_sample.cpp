@@ -11,6 +11,7 @@
 #include "elastic/mesh/mesh_io.h"
 #include "elastic/regions/region_spec.h"
 #include "elastic/sampling/sample_region.h"
+#include "job_file.h"
 
 namespace elastic::cli {
 namespace {
@@ -33,7 +34,9 @@ struct SampleArgs {
   bool quiet = false;
 };
 
-int run_sample(const SampleArgs& args) {
+int run_sample(const SampleArgs& args, const CLI::App& sub) {
+  require_flag(args.mesh, "--mesh");
+  require_flag(args.region, "--region");
   LoadedSurface loaded = load_surface(args.mesh, args.scheme);
   print_warnings(loaded.warnings, args.quiet);
   RegionOptions region_options;
@@ -62,6 +65,7 @@ int run_sample(const SampleArgs& args) {
 
   const SamplingStatistics& st = sampled.statistics;
   const nlohmann::json report = {
+      {"job", job_of(sub)},
       {"mesh", args.mesh},
       {"region", args.region},
       {"requested_particles", args.particles},
@@ -116,10 +120,9 @@ int run_sample(const SampleArgs& args) {
 
 ELASTIC_COMMAND("sample", "Sample a source region with the particle grid", [](CLI::App& sub) {
   auto args = std::make_shared<elastic::cli::SampleArgs>();
-  sub.add_option("--mesh", args->mesh, "Source mesh file (OBJ, OFF, PLY, STL)")->required();
+  sub.add_option("--mesh", args->mesh, "Source mesh file (OBJ, OFF, PLY, STL) (required)");
   sub.add_option("--region", args->region,
-                 "Region: disk:X,Y,Z,R | points:FILE | boundary | uv:FILE")
-      ->required();
+                 "Region (required): disk:X,Y,Z,R | points:FILE | boundary | uv:FILE");
   sub.add_option("--particles", args->particles, "Number of particles (within 5%)")
       ->check(CLI::Range(16L, 5'000'000L));
   sub.add_option("--seed", args->seed, "Seed of the initial jitter (with --jitter)");
@@ -146,5 +149,5 @@ ELASTIC_COMMAND("sample", "Sample a source region with the particle grid", [](CL
   sub.footer(
       "Example:\n  elastic sample --mesh cap.obj --region disk:0,0,1,0.5 --particles 5000 "
       "--out grid.obj --report grid.json");
-  return [args] { return elastic::cli::run_sample(*args); };
+  return [args, &sub] { return elastic::cli::run_sample(*args, sub); };
 });

@@ -37,6 +37,7 @@ struct CommandRegistrar {
 #define ELASTIC_CONCAT_INNER(a, b) a##b
 #define ELASTIC_CONCAT(a, b) ELASTIC_CONCAT_INNER(a, b)
 /// ELASTIC_COMMAND("name", "description", [](CLI::App& sub) { ...; return [&]{ return 0; }; });
-#define ELASTIC_COMMAND(name, description, setup)               \
+/// (variadic so that the setup lambda may contain commas, e.g. a capture list [a, &sub]).
+#define ELASTIC_COMMAND(name, description, ...)                 \
   static const ::elastic::cli::CommandRegistrar ELASTIC_CONCAT( \
-      elastic_command_, __LINE__)(::elastic::cli::Command{name, description, setup})
+      elastic_command_, __LINE__)(::elastic::cli::Command{name, description, __VA_ARGS__})

@@ -8,6 +8,7 @@
 
 #include "command.h"
 #include "elastic/core/error.h"
+#include "job_file.h"
 
 namespace elastic::cli {
 std::vector<Command>& command_registry() {
@@ -25,11 +26,18 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
 
   std::function<int()> run;
+  CLI::App* chosen = nullptr;
   for (const Command& command : command_registry()) {
     CLI::App* sub = app.add_subcommand(command.name, command.description);
+    // Defaults are captured so that a report's "job" records every value the run used.
+    sub->option_defaults()->always_capture_default();
     auto runner = std::make_shared<std::function<int()>>();
     *runner = command.setup(*sub);
-    sub->callback([runner, &run] { run = *runner; });
+    if (command.name != "version") add_job_option(*sub);
+    sub->callback([runner, sub, &run, &chosen] {
+      run = *runner;
+      chosen = sub;
+    });
   }
 
   try {
@@ -40,7 +48,11 @@ int main(int argc, char** argv) {
   }
 
   try {
+    if (chosen != nullptr) apply_job_file(*chosen);
     return run ? run() : kUsage;
+  } catch (const UsageError& e) {
+    std::cerr << "elastic: " << e.what() << "\nRun with --help for more information.\n";
+    return kUsage;
   } catch (const elastic::IoError& e) {
     std::cerr << "elastic: " << e.what() << '\n';
     return e.direction() == elastic::IoError::Direction::Write ? kCantCreate : kNoInput;

@@ -1,0 +1,186 @@
+#include "map_job.h"
+
+#include <chrono>
+#include <fstream>
+#include <iostream>
+#include <sstream>
+
+#include "elastic/core/atomic_file.h"
+#include "elastic/core/error.h"
+#include "elastic/regions/region_spec.h"
+#include "job_file.h"
+
+namespace elastic::cli {
+namespace {
+
+double seconds_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+}  // namespace
+
+Eigen::Vector3d parse_point(const std::string& text, const std::string& flag) {
+  Eigen::Vector3d p;
+  char c1 = 0, c2 = 0;
+  std::istringstream in(text);
+  if (!(in >> p.x() >> c1 >> p.y() >> c2 >> p.z()) || c1 != ',' || c2 != ',' || !p.allFinite()) {
+    throw InvalidInputError(flag, "expected X,Y,Z, got '" + text + "'");
+  }
+  std::string rest;
+  if (in >> rest) throw InvalidInputError(flag, "expected X,Y,Z, got '" + text + "'");
+  return p;
+}
+
+void add_map_flags(CLI::App& sub, MapJob& a) {
+  sub.add_option("--source", a.source, "Source mesh file (OBJ, OFF, PLY, STL)");
+  sub.add_option("--source-image", a.source_image,
+                 "Source image (PNG, JPEG, ...) on a plane; region: rectangle or ellipse");
+  sub.add_option("--image-width", a.image_width, "Physical width of the source image's plane")
+      ->check(CLI::PositiveNumber);
+  sub.add_option("--source-region", a.source_region,
+                 "Source region: disk:X,Y,Z,R | points:FILE | boundary | uv:FILE");
+  sub.add_option("--source-anchor", a.source_anchor, "X,Y,Z: start of the boundary correspondence");
+  sub.add_option("--target", a.target, "Target mesh file (required)");
+  sub.add_option("--target-region", a.target_region, "Target region (same forms)");
+  sub.add_option("--target-anchor", a.target_anchor, "X,Y,Z: start of the boundary correspondence");
+  sub.add_option("--particles", a.particles, "Number of particles (within 5%)");
+  sub.add_option("--solver", a.solver, "lbfgs (fast) or explicit (the paper's integrator)")
+      ->check(CLI::IsMember({"lbfgs", "explicit"}));
+  sub.add_option("--rest-scale", a.rest_scale, "boundary | area | none")
+      ->check(CLI::IsMember({"boundary", "area", "none"}));
+  sub.add_option("--scheme", a.scheme, "Subdivision scheme for both meshes")
+      ->check(CLI::IsMember({"auto", "loop", "catmull-clark"}));
+  sub.add_option("--subdivide", a.subdivide,
+                 "Refine the particle grid K times after the map and relax briefly (end of §4.3)")
+      ->check(CLI::Range(0, 4));
+  sub.add_option("--threads", a.threads, "Threads (0: all)")->check(CLI::Range(0, 1024));
+  sub.add_option("--seed", a.seed, "Seed of the sampling's random jitter");
+  sub.add_option("--max-iterations", a.max_iterations, "Solver iteration budget (0: default)")
+      ->check(CLI::NonNegativeNumber);
+  sub.add_option("--report", a.report, "Write the JSON report to this file");
+  sub.add_flag("--quiet,-q", a.quiet, "No progress, no warnings: only results");
+}
+
+std::unique_ptr<MapSession> run_map_job(const MapJob& job, const ProgressCallback& progress) {
+  const auto start = std::chrono::steady_clock::now();
+  require_flag(job.target, "--target");
+  if (job.particles < 16 || job.particles > 5'000'000) {
+    throw InvalidInputError("--particles",
+                            "must be between 16 and 5000000, got " + std::to_string(job.particles));
+  }
+  if (job.source.empty() == job.source_image.empty()) {
+    throw UsageError("give exactly one of --source MESH and --source-image IMAGE");
+  }
+  auto session = std::make_unique<MapSession>();
+  MapSession& s = *session;
+  // An image source is a plane carrying the image; its region is the rectangle or the inscribed
+  // ellipse.
+  if (!job.source_image.empty()) {
+    if (job.source_region != "boundary" && job.source_region != "rectangle" &&
+        job.source_region != "ellipse") {
+      throw InvalidInputError(
+          "--source-region", "with --source-image it is 'rectangle' (default) or 'ellipse', got '" +
+                                 job.source_region + "'");
+    }
+    s.image = make_image_plane(
+        job.source_image, {.width = job.image_width,
+                           .shape = job.source_region == "ellipse" ? ImageRegionShape::Ellipse
+                                                                   : ImageRegionShape::Rectangle});
+  }
+  if (progress) progress({.stage = "load"});
+  s.source = s.image ? surface_from_mesh(s.image->mesh, job.source_image, job.scheme)
+                     : load_surface(job.source, job.scheme);
+  print_warnings(s.source.warnings, job.quiet);
+  s.target = load_surface(job.target, job.scheme);
+  print_warnings(s.target.warnings, job.quiet);
+
+  RegionSpec source_spec =
+      s.image ? s.image->region : parse_region_spec(job.source_region, "--source-region");
+  if (!job.source_anchor.empty())
+    source_spec.anchor = parse_point(job.source_anchor, "--source-anchor");
+  RegionSpec target_spec = parse_region_spec(job.target_region, "--target-region");
+  if (!job.target_anchor.empty())
+    target_spec.anchor = parse_point(job.target_anchor, "--target-anchor");
+  s.source_region = make_region(*s.source.projector, source_spec, {.name = "--source-region"});
+  s.target_region = make_region(*s.target.projector, target_spec, {.name = "--target-region"});
+  s.seconds_loading = seconds_since(start);
+
+  MapOptions options;
+  options.sampling.layout.particles = job.particles;
+  options.sampling.layout.name = "--source-region";
+  options.sampling.sampling.seed = job.seed;
+  options.rest_scale = parse_rest_scale(job.rest_scale, "--rest-scale");
+  options.relaxation.solver = job.solver == "explicit" ? SolverKind::Faithful : SolverKind::Fast;
+  options.relaxation.threads = job.threads;
+  options.relaxation.max_iterations = job.max_iterations;
+  if (job.subdivide > 0) {
+    throw UsageError("--subdivide is not available in this build yet");
+  }
+  options.progress = progress;
+  options.relaxation.progress = progress;
+  s.result = map_regions(*s.source.projector, s.source_region, *s.target.projector, s.target_region,
+                         options);
+  s.seconds_total = seconds_since(start);
+  return session;
+}
+
+nlohmann::json map_report(const MapJob& job, const MapSession& session,
+                          const nlohmann::json& job_json) {
+  const MapResult& r = session.result;
+  const RelaxationResult& x = r.relaxation;
+  const SamplingStatistics& s = r.sampling.statistics;
+  return {{"job", job_json},
+          {"particles", s.particles},
+          {"springs", s.normal_springs + s.angular_springs},
+          {"springs_normal", s.normal_springs},
+          {"springs_angular", s.angular_springs},
+          {"boundary_particles", s.boundary_particles},
+          {"solver", job.solver},
+          {"iterations", x.iterations},
+          {"converged", x.converged},
+          {"reason", std::string(to_string(x.reason))},
+          {"seconds",
+           {{"total", session.seconds_total},
+            {"loading", session.seconds_loading},
+            {"setup", r.seconds_sampling + r.seconds_naive + x.setup_seconds},
+            {"solve", x.solve_seconds},
+            {"sampling", r.seconds_sampling},
+            {"naive_map", r.seconds_naive},
+            {"solver_setup", x.setup_seconds},
+            {"mapping", r.seconds_mapping}}},
+          {"energy",
+           {{"length", x.length_energy},
+            {"angle", x.angular_energy},
+            {"magnet", x.magnet_energy},
+            {"initial", x.initial_energy}}},
+          {"gradient", {{"relative", x.relative_gradient}, {"norm", x.gradient_norm}}},
+          {"folds", x.folded_faces},
+          {"initial_folds", x.initial_folded_faces},
+          {"boundary_residual", x.boundary_residual},
+          {"rest_scale", {{"mode", job.rest_scale}, {"factor", r.rest_scale}}},
+          {"sampling",
+           {{"spacing_min", s.spacing_min},
+            {"spacing_median", s.spacing_median},
+            {"spacing_max", s.spacing_max},
+            {"density_ratio", s.density_ratio}}}};
+}
+
+void write_report(const std::string& path, const nlohmann::json& report) {
+  if (path.empty()) return;
+  write_file_atomically(path, [&](std::ofstream& out) { out << report.dump(2) << '\n'; });
+}
+
+void print_map_summary(const MapJob& job, const MapSession& session) {
+  const MapResult& r = session.result;
+  const RelaxationResult& x = r.relaxation;
+  const SamplingStatistics& s = r.sampling.statistics;
+  std::cout << "particles " << s.particles << ", springs " << s.normal_springs + s.angular_springs
+            << ", solver " << job.solver << ", " << x.iterations << " iterations, "
+            << (x.converged ? "converged" : "NOT converged") << " (" << to_string(x.reason) << ")\n"
+            << "length energy " << x.length_energy << ", angle energy " << x.angular_energy
+            << ", relative gradient " << x.relative_gradient << ", folds " << x.folded_faces
+            << ", boundary residual " << x.boundary_residual << '\n'
+            << "seconds: total " << session.seconds_total << ", solve " << x.solve_seconds << '\n';
+}
+
+}  // namespace elastic::cli

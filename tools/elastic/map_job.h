@@ -1,0 +1,84 @@
+#pragma once
+// The job shared by `elastic map`, `paste` and `compare`: the flags that choose the source and the
+// target regions and how the map is computed, loading the inputs, running map_regions, and the
+// JSON report of `elastic map` (docs/getting-started.md lists its keys).
+//
+//   auto job = std::make_shared<MapJob>();
+//   add_map_flags(sub, *job);                       // in the ELASTIC_COMMAND setup
+//   ...
+//   const std::unique_ptr<MapSession> s = run_map_job(*job);   // in the run function
+//   nlohmann::json report = map_report(*job, *s, job_of(sub));
+
+#include <CLI/CLI.hpp>
+#include <Eigen/Core>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+
+#include "cli_common.h"
+#include "elastic/mapping/map_regions.h"
+#include "elastic/regions/image_source.h"
+#include "elastic/regions/region.h"
+
+namespace elastic::cli {
+
+struct MapJob {
+  std::string source;                      ///< --source MESH
+  std::string source_image;                ///< --source-image IMAGE (a plane carrying the image)
+  double image_width = 2.0;                ///< --image-width: physical width of the image's plane
+  std::string source_region = "boundary";  ///< --source-region SPEC
+  std::string source_anchor;               ///< --source-anchor X,Y,Z
+  std::string target;                      ///< --target MESH (required)
+  std::string target_region = "boundary";  ///< --target-region SPEC
+  std::string target_anchor;               ///< --target-anchor X,Y,Z
+  long particles = 1000;                   ///< --particles N
+  std::string solver = "lbfgs";            ///< --solver lbfgs|explicit
+  std::string rest_scale = "boundary";     ///< --rest-scale boundary|area|none
+  std::string scheme = "auto";             ///< --scheme auto|loop|catmull-clark
+  int subdivide = 0;                       ///< --subdivide K: refinement levels after the map
+  int threads = 0;                         ///< --threads N (0: all)
+  unsigned long seed = 0;                  ///< --seed S
+  long max_iterations = 0;                 ///< --max-iterations (0: the solver's default)
+  std::string report;                      ///< --report FILE
+  bool quiet = false;                      ///< --quiet
+};
+
+/// Adds the MapJob flags to a subcommand (--report and --quiet included).
+void add_map_flags(CLI::App& sub, MapJob& job);
+
+/// Everything a map run loaded and computed. Heap-held and not movable: the regions reference the
+/// surfaces, and the MapResult's Mapping references the projectors, regions and disk maps.
+struct MapSession {
+  std::optional<ImagePlane> image;  ///< when the source is an image
+  LoadedSurface source;
+  LoadedSurface target;
+  Region source_region;
+  Region target_region;
+  MapResult result;
+  double seconds_loading = 0.0;  ///< reading, repairing, limit surfaces, projectors, regions
+  double seconds_total = 0.0;    ///< the whole run_map_job
+  MapSession() = default;
+  MapSession(const MapSession&) = delete;
+  MapSession& operator=(const MapSession&) = delete;
+};
+
+/// Validates the job, loads the surfaces and regions, and maps. Progress goes to `progress`
+/// (stage and solver iterations). \throws UsageError / InvalidInputError / IoError naming the flag
+/// or file; NumericalError when a stage fails.
+std::unique_ptr<MapSession> run_map_job(const MapJob& job, const ProgressCallback& progress = {});
+
+/// The report of `elastic map` (keys in docs/getting-started.md) with `job` recorded under "job".
+nlohmann::json map_report(const MapJob& job, const MapSession& session,
+                          const nlohmann::json& job_json);
+
+/// Writes `report` to `path` atomically (pretty JSON), if `path` is not empty.
+void write_report(const std::string& path, const nlohmann::json& report);
+
+/// The two-line summary `elastic map` prints.
+void print_map_summary(const MapJob& job, const MapSession& session);
+
+/// Parses "X,Y,Z" (finite numbers). \throws InvalidInputError naming `flag`.
+Eigen::Vector3d parse_point(const std::string& text, const std::string& flag);
+
+}  // namespace elastic::cli
