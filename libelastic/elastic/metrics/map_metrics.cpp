@@ -1,0 +1,333 @@
+#include "elastic/metrics/map_metrics.h"
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <numbers>
+#include <string>
+
+#include "elastic/core/error.h"
+
+namespace elastic {
+
+namespace {
+
+struct MetricName {
+  TriangleMetric metric;
+  std::string_view name;
+  double perfect;
+};
+constexpr std::array<MetricName, 7> kMetricNames{{
+    {TriangleMetric::AngleError, "angle_error_deg", 0.0},
+    {TriangleMetric::StretchL2, "stretch_l2", 1.0},
+    {TriangleMetric::StretchLinf, "stretch_linf", 1.0},
+    {TriangleMetric::InverseStretchL2, "inverse_stretch_l2", 1.0},
+    {TriangleMetric::AreaDistortion, "area_distortion", 0.0},
+    {TriangleMetric::ConformalDistortion, "conformal_distortion", 1.0},
+    {TriangleMetric::SymmetricDirichlet, "symmetric_dirichlet", 4.0},
+}};
+
+const MetricName& lookup(TriangleMetric metric) {
+  for (const auto& entry : kMetricNames) {
+    if (entry.metric == metric) return entry;
+  }
+  return kMetricNames[0];
+}
+
+// The corner angle at a between the edges to b and c, in [0, pi]. atan2 of the cross and dot
+// products keeps full relative accuracy for angles near 0 and pi, where acos of a cosine does not.
+double corner_angle(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c) {
+  const Eigen::Vector3d e = b - a;
+  const Eigen::Vector3d f = c - a;
+  return std::atan2(e.cross(f).norm(), e.dot(f));
+}
+
+bool all_finite(const Eigen::Matrix3Xd& m) {
+  return m.allFinite();
+}
+
+}  // namespace
+
+std::string_view to_string(TriangleMetric metric) {
+  return lookup(metric).name;
+}
+
+TriangleMetric parse_triangle_metric(std::string_view text, std::string_view input) {
+  std::string known;
+  for (const auto& entry : kMetricNames) {
+    if (entry.name == text) return entry.metric;
+    known += (known.empty() ? "" : ", ") + std::string(entry.name);
+  }
+  throw InvalidInputError(std::string(input), "unknown metric '" + std::string(text) +
+                                                  "' (expected one of " + known + ")");
+}
+
+double perfect_value(TriangleMetric metric) {
+  return lookup(metric).perfect;
+}
+
+const std::vector<TriangleMetric>& all_triangle_metrics() {
+  static const std::vector<TriangleMetric> all = [] {
+    std::vector<TriangleMetric> out;
+    for (const auto& entry : kMetricNames) out.push_back(entry.metric);
+    return out;
+  }();
+  return all;
+}
+
+const std::vector<double>& TriangleValues::values(TriangleMetric metric) const {
+  switch (metric) {
+    case TriangleMetric::AngleError:
+      return angle_error_deg;
+    case TriangleMetric::StretchL2:
+      return stretch_l2;
+    case TriangleMetric::StretchLinf:
+      return s1;
+    case TriangleMetric::InverseStretchL2:
+      return inverse_stretch_l2;
+    case TriangleMetric::AreaDistortion:
+      return area_distortion;
+    case TriangleMetric::ConformalDistortion:
+      return conformal_distortion;
+    case TriangleMetric::SymmetricDirichlet:
+      return symmetric_dirichlet;
+  }
+  return s1;
+}
+
+std::vector<Eigen::Vector3i> grid_triangles(const ParticleGrid& grid) {
+  // The same fan as Mapping::triangles(): grid faces are convex in the grid layout (quads of the
+  // regular grid, triangles of the boundary band), so any fan is valid; the first corner's is the
+  // one the mapping queries use, and using it here makes the heatmap show the mapping's triangles.
+  std::vector<Eigen::Vector3i> triangles;
+  triangles.reserve(grid.mesh.n_faces() * 2);
+  std::vector<int> corners;
+  for (const auto fh : grid.mesh.faces()) {
+    corners.clear();
+    for (const auto vh : grid.mesh.fv_range(fh)) corners.push_back(vh.idx());
+    for (size_t k = 1; k + 1 < corners.size(); ++k) {
+      triangles.emplace_back(corners[0], corners[k], corners[k + 1]);
+    }
+  }
+  return triangles;
+}
+
+MapMetrics measure_map(const ParticleGrid& grid, const Eigen::Matrix3Xd& target_positions,
+                       const MapMetricsOptions& options) {
+  const int n = grid.num_particles();
+  const std::string name = "map metrics";
+  if (target_positions.cols() != n) {
+    throw InvalidInputError(name, "target positions have " +
+                                      std::to_string(target_positions.cols()) + " columns for " +
+                                      std::to_string(n) + " particles");
+  }
+  if (!options.outside.empty() && static_cast<int>(options.outside.size()) != n) {
+    throw InvalidInputError(name, "the outside mask has " + std::to_string(options.outside.size()) +
+                                      " entries for " + std::to_string(n) + " particles");
+  }
+  const bool have_normals = options.target_normals.cols() > 0;
+  if (have_normals && options.target_normals.cols() != n) {
+    throw InvalidInputError(name, "target normals have " +
+                                      std::to_string(options.target_normals.cols()) +
+                                      " columns for " + std::to_string(n) + " particles");
+  }
+  const double sigma = options.rest_scale;
+  if (!std::isfinite(sigma) || sigma <= 0.0) {
+    throw InvalidInputError(name, "rest scale must be finite and positive");
+  }
+  if (grid.mesh.n_faces() == 0) throw InvalidInputError(name, "the particle grid has no faces");
+  if (grid.springs.empty()) throw InvalidInputError(name, "the particle grid has no springs built");
+
+  const auto is_outside = [&](int p) { return !options.outside.empty() && options.outside[p]; };
+  std::vector<char> skip(n, 0);
+  for (int p = 0; p < n; ++p) skip[p] = is_outside(p) ? 1 : 0;
+  // Outside particles may carry anything (NaN, zeros): only the placed ones must be finite.
+  for (int p = 0; p < n; ++p) {
+    if (!skip[p] && !target_positions.col(p).allFinite()) {
+      throw InvalidInputError(
+          name, "target position of particle " + std::to_string(p) + " is not finite");
+    }
+  }
+  const Eigen::Matrix3Xd source = grid.source_positions();
+  if (!all_finite(source)) throw InvalidInputError(name, "a source position is not finite");
+
+  MapMetrics out;
+  for (int p = 0; p < n; ++p) out.outside += skip[p] ? 1 : 0;
+
+  // Length energy (eq. 13, normalised by the energy of collapsing every spring to a point).
+  {
+    double num = 0.0, den = 0.0;
+    for (const Spring& s : grid.springs) {
+      if (s.i < 0 || s.i >= n || s.j < 0 || s.j >= n) {
+        throw InvalidInputError(name, "a spring index is out of range");
+      }
+      if (skip[s.i] || skip[s.j]) continue;
+      const double rest = sigma * s.rest;
+      const double len = (target_positions.col(s.j) - target_positions.col(s.i)).norm();
+      num += (len - rest) * (len - rest);
+      den += rest * rest;
+      ++out.measured_springs;
+    }
+    out.length_energy = den > 0.0 ? num / den : 0.0;
+  }
+
+  out.triangles = grid_triangles(grid);
+  const int nt = static_cast<int>(out.triangles.size());
+  TriangleValues& tv = out.per_triangle;
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const double inf = std::numeric_limits<double>::infinity();
+  for (auto* v : {&tv.s1, &tv.s2, &tv.source_area, &tv.target_area, &tv.angle_error_deg,
+                  &tv.stretch_l2, &tv.inverse_stretch_l2, &tv.area_distortion,
+                  &tv.conformal_distortion, &tv.symmetric_dirichlet}) {
+    v->assign(nt, nan);
+  }
+  tv.folded.assign(nt, 0);
+  tv.excluded.assign(nt, 0);
+
+  double w_sum = 0.0, w_stretch = 0.0, w_area = 0.0, w_conf = 0.0, w_sd = 0.0;
+  double w_inv_sum = 0.0, w_inv_stretch = 0.0;
+  double w_regular = 0.0;  // source area of the non-degenerate triangles
+  double max_s1 = 0.0, max_inv = 0.0;
+  double angle_sum = 0.0;
+  long angle_count = 0;
+  int folds = 0;
+  constexpr double kDeg = 180.0 / std::numbers::pi;
+
+  for (int t = 0; t < nt; ++t) {
+    const Eigen::Vector3i& tri = out.triangles[t];
+    if (skip[tri[0]] || skip[tri[1]] || skip[tri[2]]) {
+      tv.excluded[t] = 1;
+      ++out.outside_triangles;
+      continue;
+    }
+    const Eigen::Vector3d p0 = source.col(tri[0]), p1 = source.col(tri[1]), p2 = source.col(tri[2]);
+    const Eigen::Vector3d q0 = target_positions.col(tri[0]), q1 = target_positions.col(tri[1]),
+                          q2 = target_positions.col(tri[2]);
+    const Eigen::Vector3d e = p1 - p0, f = p2 - p0, eq = q1 - q0, fq = q2 - q0;
+    const Eigen::Vector3d source_normal = e.cross(f), target_normal = eq.cross(fq);
+    const double source_area = 0.5 * source_normal.norm();
+    const double target_area = 0.5 * target_normal.norm();
+    if (!(source_area > 0.0)) {
+      throw InvalidInputError(
+          name, "grid triangle " + std::to_string(t) + " has zero area on the source");
+    }
+
+    // Singular values without a target frame: with S the source edges in an orthonormal frame of
+    // the source plane and G_s = S^T S, G_t = T^T T the Gram matrices of the source and target
+    // edge vectors (frame-independent dot products of 3D edges), J^T J = S^-T G_t S^-1, hence
+    //   s1^2 + s2^2 = trace(J^T J) = trace(G_s^-1 G_t),   s1 s2 = |det J| = A_t / A_s.
+    // This also holds for a degenerate target (A_t = 0), where a target frame would not exist.
+    Eigen::Matrix2d gs, gt;
+    gs << e.dot(e), e.dot(f), e.dot(f), f.dot(f);
+    gt << eq.dot(eq), eq.dot(fq), eq.dot(fq), fq.dot(fq);
+    // det G_s = |e x f|^2 = (2 A_s)^2 exactly in real arithmetic; use the cross product form,
+    // which has no cancellation for thin triangles.
+    const double det_gs = source_normal.squaredNorm();
+    Eigen::Matrix2d gs_inv;
+    gs_inv << gs(1, 1), -gs(0, 1), -gs(1, 0), gs(0, 0);
+    gs_inv /= det_gs;
+    const double sum_sq = (gs_inv * gt).trace() / (sigma * sigma);    // s1^2 + s2^2
+    const double prod = target_area / source_area / (sigma * sigma);  // s1 s2
+    // s1, s2 from their sum of squares and product: (s1 +- s2)^2 = sum_sq +- 2 prod. The smaller
+    // one as prod / s1 keeps its relative accuracy when s2 << s1.
+    const double plus = std::sqrt(std::max(sum_sq + 2.0 * prod, 0.0));
+    const double minus = std::sqrt(std::max(sum_sq - 2.0 * prod, 0.0));
+    const double s1 = 0.5 * (plus + minus);
+    const double s2 = s1 > 0.0 ? prod / s1 : 0.0;
+
+    tv.s1[t] = s1;
+    tv.s2[t] = s2;
+    tv.source_area[t] = source_area;
+    tv.target_area[t] = target_area;
+    tv.stretch_l2[t] = std::sqrt(0.5 * sum_sq);
+
+    const bool degenerate = !(prod >= options.degenerate_area_ratio);
+    bool folded = degenerate;
+    if (!degenerate && have_normals) {
+      // Inverted when the target triangle's normal points against the surface: compare with the
+      // sum of the three corners' unit normals (robust to one corner normal being off).
+      const Eigen::Vector3d surface_normal = options.target_normals.col(tri[0]) +
+                                             options.target_normals.col(tri[1]) +
+                                             options.target_normals.col(tri[2]);
+      folded = target_normal.dot(surface_normal) <= 0.0;
+    }
+    tv.folded[t] = folded ? 1 : 0;
+    folds += folded ? 1 : 0;
+    out.degenerate += degenerate ? 1 : 0;
+
+    // Corner angles (unsigned, in each triangle's own plane).
+    double worst = 0.0;
+    for (int k = 0; k < 3; ++k) {
+      const int a = tri[k], b = tri[(k + 1) % 3], c = tri[(k + 2) % 3];
+      const double src = corner_angle(source.col(a), source.col(b), source.col(c));
+      const double tgt =
+          corner_angle(target_positions.col(a), target_positions.col(b), target_positions.col(c));
+      const double diff = std::abs(tgt - src) * kDeg;
+      worst = std::max(worst, diff);
+      angle_sum += diff;
+      ++angle_count;
+    }
+    tv.angle_error_deg[t] = worst;
+    out.angle_error_max_deg = std::max(out.angle_error_max_deg, worst);
+
+    ++out.measured_triangles;
+    const double w = source_area;
+    w_sum += w;
+    w_stretch += w * 0.5 * sum_sq;
+    max_s1 = std::max(max_s1, s1);
+    if (degenerate) {
+      tv.inverse_stretch_l2[t] = inf;
+      tv.area_distortion[t] = inf;
+      tv.conformal_distortion[t] = inf;
+      tv.symmetric_dirichlet[t] = inf;
+      continue;
+    }
+    // 1/s1^2 + 1/s2^2 = (s1^2 + s2^2) / (s1 s2)^2.
+    const double inv_sum_sq = sum_sq / (prod * prod);
+    tv.inverse_stretch_l2[t] = std::sqrt(0.5 * inv_sum_sq);
+    tv.area_distortion[t] = std::abs(std::log(prod));
+    tv.conformal_distortion[t] = s1 / s2;
+    tv.symmetric_dirichlet[t] = sum_sq + inv_sum_sq;
+    w_regular += w;
+    w_area += w * tv.area_distortion[t];
+    w_conf += w * tv.conformal_distortion[t];
+    w_sd += w * tv.symmetric_dirichlet[t];
+    // The inverse map's domain is the target triangle: weight by its area.
+    w_inv_sum += target_area;
+    w_inv_stretch += target_area * 0.5 * inv_sum_sq;
+    max_inv = std::max(max_inv, 1.0 / s2);
+  }
+
+  if (w_sum > 0.0) {
+    out.stretch_l2 = std::sqrt(w_stretch / w_sum);
+    out.stretch_linf = max_s1;
+  }
+  // Degenerate triangles have no finite value in these means: they are left out (and counted in
+  // `folds` and `degenerate`).
+  if (w_regular > 0.0) {
+    out.inverse_stretch_linf = max_inv;
+    out.area_distortion = w_area / w_regular;
+    out.conformal_distortion = w_conf / w_regular;
+    out.symmetric_dirichlet = w_sd / w_regular;
+  }
+  if (w_inv_sum > 0.0) out.inverse_stretch_l2 = std::sqrt(w_inv_stretch / w_inv_sum);
+  if (angle_count > 0) out.angle_error_mean_deg = angle_sum / static_cast<double>(angle_count);
+  out.folds = have_normals ? folds : -1;
+  return out;
+}
+
+Eigen::Matrix3Xd surface_normals(const LimitSurface& surface,
+                                 const std::vector<SurfacePoint>& points,
+                                 const std::vector<char>& skip) {
+  const int n = static_cast<int>(points.size());
+  Eigen::Matrix3Xd normals = Eigen::Matrix3Xd::Zero(3, n);
+  for (int p = 0; p < n; ++p) {
+    if ((!skip.empty() && skip[p]) || !points[p].valid()) continue;
+    normals.col(p) = surface.curvature(points[p]).normal;
+  }
+  return normals;
+}
+
+}  // namespace elastic
