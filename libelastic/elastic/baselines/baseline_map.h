@@ -42,9 +42,12 @@ BaselineKind parse_baseline_kind(std::string_view text, std::string_view input =
 struct BaselineOptions {
   BaselineKind kind = BaselineKind::Lscm;  ///< which flattening
   int arap_iterations = 50;                ///< CGAL ARAP iterations (local/global alternations)
-  /// CGAL ARAP's lambda (Liu et al.'s hybrid model): 0 is pure ARAP; larger values favour
-  /// similarity (ASAP-like) cells. CGAL's default is 1000; 0 gives the rigid-most map.
-  double arap_lambda = 0.0;
+  /// CGAL ARAP's lambda (Liu et al.'s hybrid model): 0 is as-similar-as-possible (the same as
+  /// LSCM); larger values favour rigid cells. CGAL's default, 1000, is ARAP for practical purposes.
+  double arap_lambda = 1000.0;
+  /// ARAP stops when one iteration changes the energy by less than this fraction (CGAL's
+  /// tolerance; <= 0 always runs arap_iterations).
+  double arap_tolerance = 1e-6;
   /// Common correspondence parameters s = i / n sampled on both boundaries to fit the alignment.
   int alignment_samples = 2048;
   /// Barycentric tolerance of point location in the flattenings (relative to a triangle: 1e-9 is
