@@ -1,0 +1,154 @@
+#include "compare_methods.h"
+
+#include <cmath>
+#include <iomanip>
+#include <sstream>
+
+#include "elastic/core/error.h"
+#include "elastic/mesh/mesh_io.h"
+
+namespace elastic::cli {
+namespace {
+
+// Measures one placement of the session's particles on the target.
+MethodMeasurement measure(const MapSession& session, std::string name,
+                          const Eigen::Matrix3Xd& positions,
+                          const std::vector<SurfacePoint>& points, std::vector<char> outside) {
+  const ParticleGrid& grid = session.result.sampling.grid;
+  MethodMeasurement m;
+  m.name = std::move(name);
+  MapMetricsOptions options;
+  options.rest_scale = session.result.rest_scale;
+  // A particle without a valid target surface point has no normal and no defined place: it is
+  // treated as outside (the baselines flag theirs; the others have none in practice).
+  outside.resize(points.size(), 0);
+  for (size_t p = 0; p < points.size(); ++p) {
+    if (!points[p].valid()) outside[p] = 1;
+  }
+  options.target_normals = surface_normals(*session.target.surface, points, outside);
+  options.outside = std::move(outside);
+  m.metrics = measure_map(grid, positions, options);
+  m.positions = positions;
+  m.ok = true;
+  return m;
+}
+
+}  // namespace
+
+std::vector<MethodMeasurement> compare_methods(const MapSession& session,
+                                               const CompareOptions& options) {
+  const MapResult& r = session.result;
+  const ParticleGrid& grid = r.sampling.grid;
+  std::vector<MethodMeasurement> out;
+
+  MethodMeasurement elastic =
+      measure(session, "elastic", r.relaxation.positions, r.relaxation.points, {});
+  elastic.seconds = r.seconds_naive + r.relaxation.setup_seconds + r.relaxation.solve_seconds;
+  elastic.extra = {{"iterations", r.relaxation.iterations},
+                   {"converged", r.relaxation.converged},
+                   {"reason", std::string(to_string(r.relaxation.reason))},
+                   {"solver_folded_faces", r.relaxation.folded_faces}};
+  out.push_back(std::move(elastic));
+
+  MethodMeasurement naive = measure(session, "naive", r.naive.positions, r.naive.points, {});
+  naive.seconds = r.seconds_naive;
+  out.push_back(std::move(naive));
+
+  for (const BaselineKind kind : options.baselines) {
+    const std::string name(to_string(kind));
+    try {
+      BaselineOptions baseline_options;
+      baseline_options.kind = kind;
+      const BaselineResult b =
+          map_baseline(grid, *session.source.projector, session.source_region,
+                       *session.target.projector, session.target_region, baseline_options);
+      MethodMeasurement m = measure(session, name, b.positions, b.points, b.outside);
+      m.seconds = b.seconds;
+      m.extra = {{"alignment_scale", b.alignment_scale},
+                 {"alignment_rotation", b.alignment_rotation},
+                 {"alignment_rms", b.alignment_rms},
+                 {"source_flipped_triangles", b.source_flipped_triangles},
+                 {"target_flipped_triangles", b.target_flipped_triangles}};
+      out.push_back(std::move(m));
+    } catch (const NumericalError& e) {
+      // A flattening that fails is a result about that baseline, not a failure of the comparison.
+      MethodMeasurement m;
+      m.name = name;
+      m.error = e.what();
+      out.push_back(std::move(m));
+    }
+  }
+
+  if (!options.heatmap_dir.empty()) {
+    std::filesystem::create_directories(options.heatmap_dir);
+    // One colour range for all methods (ElasticPaint's automatic range unless fixed), so the same
+    // colour means the same distortion in every file.
+    const HeatmapResult first =
+        make_heatmap(out.front().positions, out.front().metrics, options.heatmap);
+    HeatmapOptions shared = options.heatmap;
+    shared.low = first.low;
+    shared.high = first.high;
+    for (const MethodMeasurement& m : out) {
+      if (!m.ok) continue;
+      write_mesh(options.heatmap_dir / (m.name + ".ply"),
+                 make_heatmap(m.positions, m.metrics, shared).mesh);
+    }
+  }
+  return out;
+}
+
+nlohmann::json measurement_json(const MethodMeasurement& m) {
+  nlohmann::json j;
+  j["seconds"] = m.seconds;
+  if (!m.ok) {
+    j["error"] = m.error;
+    return j;
+  }
+  const MapMetrics& x = m.metrics;
+  j["length_energy"] = x.length_energy;
+  j["angle_error_mean_deg"] = x.angle_error_mean_deg;
+  j["angle_error_max_deg"] = x.angle_error_max_deg;
+  j["stretch_l2"] = x.stretch_l2;
+  j["stretch_linf"] = x.stretch_linf;
+  j["inverse_stretch_l2"] = x.inverse_stretch_l2;
+  j["inverse_stretch_linf"] = x.inverse_stretch_linf;
+  j["area_distortion"] = x.area_distortion;
+  j["conformal_distortion"] = x.conformal_distortion;
+  j["symmetric_dirichlet"] = x.symmetric_dirichlet;
+  j["folds"] = x.folds;
+  j["degenerate"] = x.degenerate;
+  j["outside"] = x.outside;
+  j["outside_triangles"] = x.outside_triangles;
+  j["measured_triangles"] = x.measured_triangles;
+  for (const auto& [key, value] : m.extra.items()) j[key] = value;
+  return j;
+}
+
+std::string markdown_table(const std::vector<MethodMeasurement>& methods) {
+  std::ostringstream s;
+  s << "| method | length energy | angle err mean (deg) | angle err max (deg) | stretch L2 | "
+       "stretch Linf | inv. stretch L2 | area dist. | conformal | sym. Dirichlet | folds | "
+       "outside | seconds |\n"
+    << "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+  const auto num = [](double v, int digits = 4) {
+    std::ostringstream o;
+    o << std::setprecision(digits) << v;
+    return o.str();
+  };
+  for (const MethodMeasurement& m : methods) {
+    s << "| " << m.name << " | ";
+    if (!m.ok) {
+      s << "failed: " << m.error << " |||||||||||\n";
+      continue;
+    }
+    const MapMetrics& x = m.metrics;
+    s << num(x.length_energy) << " | " << num(x.angle_error_mean_deg) << " | "
+      << num(x.angle_error_max_deg) << " | " << num(x.stretch_l2) << " | " << num(x.stretch_linf)
+      << " | " << num(x.inverse_stretch_l2) << " | " << num(x.area_distortion) << " | "
+      << num(x.conformal_distortion) << " | " << num(x.symmetric_dirichlet) << " | " << x.folds
+      << " | " << x.outside << " | " << num(m.seconds, 3) << " |\n";
+  }
+  return s.str();
+}
+
+}  // namespace elastic::cli
