@@ -2,9 +2,13 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <iostream>
+#include <memory>
+#include <string>
 
 #include "elastic/mesh/mesh_io.h"
 #include "elastic/mesh/mesh_validation.h"
@@ -39,19 +43,65 @@ LoadedSurface surface_from_mesh(PolygonMesh mesh, const std::string& path,
   return loaded;
 }
 
+namespace {
+
+/// How far a stage has come, in [0, 1], or a negative value when nothing tells. Stages with a known
+/// count use it; a minimisation uses its relative gradient, which falls from 1 towards the
+/// tolerance roughly geometrically, so log(g) / log(tolerance) grows about linearly in time.
+double stage_fraction(const Progress& p, double gradient_tolerance) {
+  if (p.total > 0) return std::clamp(static_cast<double>(p.iteration) / p.total, 0.0, 1.0);
+  if (p.gradient > 0.0 && p.gradient < 1.0) {
+    return std::clamp(std::log(p.gradient) / std::log(gradient_tolerance), 0.0, 1.0);
+  }
+  return -1.0;
+}
+
+}  // namespace
+
 ProgressCallback terminal_progress(bool quiet) {
   if (quiet || !::isatty(STDERR_FILENO)) return {};
-  auto start = std::chrono::steady_clock::now();
-  return [start](const Progress& p) {
-    const double seconds =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  using Clock = std::chrono::steady_clock;
+  struct State {
+    Clock::time_point start = Clock::now();
+    Clock::time_point stage_start = Clock::now();
+    Clock::time_point last_draw;
+    std::string stage;
+  };
+  auto state = std::make_shared<State>();
+  return [state](const Progress& p) {
+    const Clock::time_point now = Clock::now();
+    if (p.stage != state->stage) {
+      state->stage = std::string(p.stage);
+      state->stage_start = now;
+    } else if (now - state->last_draw < std::chrono::milliseconds(50)) {
+      return true;  // at most 20 redraws a second
+    }
+    state->last_draw = now;
+    const double seconds = std::chrono::duration<double>(now - state->start).count();
+    const double in_stage = std::chrono::duration<double>(now - state->stage_start).count();
+    constexpr double kGradientTolerance = 1e-6;  // the solvers' default relative tolerance
+    const double fraction = stage_fraction(p, kGradientTolerance);
+    // [#########...........]: the stage's progress when it can be known.
+    constexpr int kWidth = 20;
+    std::string bar;
+    if (fraction >= 0.0) {
+      const int filled = static_cast<int>(fraction * kWidth + 0.5);
+      bar = "[" + std::string(static_cast<size_t>(filled), '#') +
+            std::string(static_cast<size_t>(kWidth - filled), '.') + "] ";
+    }
+    std::string left;
+    if (fraction > 0.05 && in_stage > 0.5) {
+      char text[32];
+      std::snprintf(text, sizeof text, "  ~%.0fs left", in_stage * (1.0 - fraction) / fraction);
+      left = text;
+    }
     if (p.iteration > 0 || p.energy != 0.0) {
-      std::fprintf(stderr, "\r\033[K%-10.*s it %6ld  E %.6e  |Pg|/|Pg0| %.2e  %6.2fs",
-                   static_cast<int>(p.stage.size()), p.stage.data(), p.iteration, p.energy,
-                   p.gradient, seconds);
+      std::fprintf(stderr, "\r\033[K%-18.*s %sit %5ld  E %.4e  grad %.1e  %6.1fs%s",
+                   static_cast<int>(p.stage.size()), p.stage.data(), bar.c_str(), p.iteration,
+                   p.energy, p.gradient, seconds, left.c_str());
     } else {
-      std::fprintf(stderr, "\r\033[K%-10.*s ...  %6.2fs", static_cast<int>(p.stage.size()),
-                   p.stage.data(), seconds);
+      std::fprintf(stderr, "\r\033[K%-18.*s %s...  %6.1fs", static_cast<int>(p.stage.size()),
+                   p.stage.data(), bar.c_str(), seconds);
     }
     g_line_open = true;
     return true;

@@ -109,6 +109,9 @@ ELASTIC_COMMAND(
           ->capture_default_str();
       sub.add_option("--only", args->only, "Comma-separated shape names (default: all)")
           ->check(check_names, "NAME,...");
+      sub.footer(
+          "Example:\n  elastic shapes --out meshes --resolution 32 --faces both\nwrites "
+          "<shape>_tris.obj and <shape>_quads.obj for every shape into meshes/.");
       return [args] { return run_shapes(*args); };
     });
 

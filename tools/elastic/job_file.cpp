@@ -64,7 +64,8 @@ nlohmann::json as_json(const std::string& text) {
 void add_job_option(CLI::App& sub) {
   sub.add_option("--job",
                  "Job file (JSON): flags as keys without dashes; the command line wins. A "
-                 "report's \"job\" is accepted, to repeat a run exactly");
+                 "report's \"job\" is accepted, to repeat a run exactly")
+      ->type_name("FILE");
 }
 
 void apply_job_file(CLI::App& sub) {

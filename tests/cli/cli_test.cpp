@@ -1,0 +1,167 @@
+// The `elastic` tool as users meet it: every bad input ends as one line on stderr naming the file
+// or flag, with the documented exit code (docs/cli.md), never a crash or a stack trace; job files
+// repeat a run; nothing but results goes into a pipe.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+
+#include "support.h"
+
+namespace elastic {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct CliRun {
+  int code = -1;
+  std::string out;
+  std::string err;
+};
+
+/// Runs `elastic ARGS` with stdout and stderr captured into files (so never a terminal).
+CliRun elastic(const std::string& args, const fs::path& dir) {
+  const fs::path out = dir / "stdout.txt", err = dir / "stderr.txt";
+  const std::string command = std::string("'") + ELASTIC_CLI + "' " + args + " >'" + out.string() +
+                              "' 2>'" + err.string() + "' </dev/null";
+  const int status = std::system(command.c_str());
+  CliRun run;
+  run.code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+  auto slurp = [](const fs::path& p) {
+    std::ifstream in(p);
+    std::stringstream s;
+    s << in.rdbuf();
+    return s.str();
+  };
+  run.out = slurp(out);
+  run.err = slurp(err);
+  return run;
+}
+
+std::string mesh(const std::string& name) {
+  return test::project_mesh(name).string();
+}
+
+/// The error contract: the exit code, and stderr starting with one "elastic: " line that mentions
+/// `names` (a usage error may add a "--help" hint line).
+void expect_error(const CliRun& run, int code, const std::string& names) {
+  EXPECT_EQ(run.code, code) << run.err;
+  ASSERT_FALSE(run.err.empty());
+  EXPECT_EQ(run.err.rfind("elastic: ", 0), 0u) << run.err;
+  const std::string first = run.err.substr(0, run.err.find('\n'));
+  EXPECT_NE(first.find(names), std::string::npos) << "'" << names << "' not in: " << first;
+  EXPECT_EQ(run.err.find("terminate"), std::string::npos) << run.err;
+  EXPECT_EQ(run.err.find("internal error"), std::string::npos) << run.err;
+}
+
+TEST(Cli, MissingAndMalformedFilesNameTheFile) {
+  const fs::path dir = test::scratch_dir("cli_files");
+  expect_error(elastic("info " + (dir / "nope.obj").string(), dir), 66, "nope.obj");
+  std::ofstream(dir / "broken.obj") << "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 7\n";
+  expect_error(elastic("info " + (dir / "broken.obj").string(), dir), 65, "broken.obj");
+  std::ofstream(dir / "nan.obj") << "v 0 0 nan\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+  expect_error(
+      elastic("map --source " + (dir / "nan.obj").string() + " --target " + mesh("cap_quads.obj"),
+              dir),
+      65, "nan.obj");
+}
+
+TEST(Cli, NonManifoldMeshIsRefusedByName) {
+  ELASTIC_REQUIRE_SHARED_MESH(path, "osd_catmark_nonman_edges.obj");
+  const fs::path dir = test::scratch_dir("cli_nonmanifold");
+  const std::string bad = path.string();
+  expect_error(elastic("map --source " + bad + " --target " + mesh("cap_quads.obj"), dir), 65,
+               "osd_catmark_nonman_edges.obj");
+}
+
+TEST(Cli, BadRegionsAndValuesNameTheFlag) {
+  const fs::path dir = test::scratch_dir("cli_values");
+  const std::string base =
+      "map --source " + mesh("plane_quads.obj") + " --target " + mesh("cap_quads.obj") + " ";
+  // A disk centred far off the surface.
+  expect_error(elastic(base + "--source-region disk:0,0,50,0.5", dir), 65, "--source-region");
+  // A region that is not a disk: a disk covering the whole closed... here, a malformed spec.
+  expect_error(elastic(base + "--source-region disk:0,0", dir), 65, "--source-region");
+  expect_error(elastic(base + "--source-anchor nan,0,0", dir), 65, "--source-anchor");
+  expect_error(elastic(base + "--particles 1000000000", dir), 65, "--particles");
+  expect_error(elastic(base + "--particles 3", dir), 65, "--particles");
+  // Usage errors: an unknown flag, a missing required flag, a bad choice.
+  EXPECT_EQ(elastic(base + "--no-such-flag", dir).code, 64);
+  expect_error(elastic("map --source " + mesh("plane_quads.obj"), dir), 64, "--target");
+  EXPECT_EQ(elastic(base + "--solver newton", dir).code, 64);
+}
+
+TEST(Cli, ReportIsWrittenWholeOrNotAtAll) {
+  const fs::path dir = test::scratch_dir("cli_report");
+  const std::string base = "map -q --source " + mesh("plane_quads.obj") +
+                           " --source-region disk:0,0,0,0.8 --target " + mesh("cap_quads.obj") +
+                           " --particles 150 ";
+  // A report in a folder that does not exist: "cannot write", exit 73, nothing left behind.
+  const CliRun run = elastic(base + "--report " + (dir / "no" / "r.json").string(), dir);
+  expect_error(run, 73, "r.json");
+  EXPECT_FALSE(fs::exists(dir / "no"));
+  // A good report survives a later failing run that names it.
+  ASSERT_EQ(elastic(base + "--report " + (dir / "r.json").string(), dir).code, 0);
+  const auto size = fs::file_size(dir / "r.json");
+  const std::string failing = "map -q --source " + mesh("plane_quads.obj") +
+                              " --source-region disk:0,0,50,1 --target " + mesh("cap_quads.obj") +
+                              " --report " + (dir / "r.json").string();
+  EXPECT_EQ(elastic(failing, dir).code, 65);
+  EXPECT_EQ(fs::file_size(dir / "r.json"), size);
+}
+
+TEST(Cli, JobFileRepeatsTheRunAndFlagsWin) {
+  const fs::path dir = test::scratch_dir("cli_job");
+  const std::string report = (dir / "first.json").string();
+  const CliRun first = elastic(
+      "map --source " + mesh("plane_quads.obj") + " --source-region disk:0,0,0,0.8 --target " +
+          mesh("cap_quads.obj") + " --particles 150 --seed 3 --report " + report,
+      dir);
+  ASSERT_EQ(first.code, 0) << first.err;
+  // Nothing but results in a pipe: no progress line on stderr.
+  EXPECT_TRUE(first.err.empty()) << first.err;
+  const nlohmann::json a = nlohmann::json::parse(std::ifstream(report));
+  EXPECT_EQ(a["job"]["command"], "map");
+  EXPECT_EQ(a["job"]["particles"], 150);
+  EXPECT_EQ(a["job"]["seed"], 3);
+  // The report itself is a job file: the same run again, except for the report path.
+  const std::string second = (dir / "second.json").string();
+  ASSERT_EQ(elastic("map --job " + report + " --report " + second, dir).code, 0);
+  const nlohmann::json b = nlohmann::json::parse(std::ifstream(second));
+  EXPECT_EQ(b["particles"], a["particles"]);
+  EXPECT_EQ(b["iterations"], a["iterations"]);
+  EXPECT_EQ(b["energy"]["length"], a["energy"]["length"]);  // deterministic: bit-identical
+  // A flag on the command line wins over the job file.
+  const std::string third = (dir / "third.json").string();
+  ASSERT_EQ(elastic("map --job " + report + " --particles 100 --report " + third, dir).code, 0);
+  EXPECT_EQ(nlohmann::json::parse(std::ifstream(third))["job"]["particles"], 100);
+  // Unknown keys and jobs of another command are usage errors naming the file.
+  std::ofstream(dir / "typo.json") << R"({"particle": 100})";
+  expect_error(elastic("map --job " + (dir / "typo.json").string(), dir), 64, "typo.json");
+  std::ofstream(dir / "other.json") << R"({"command": "sample"})";
+  expect_error(elastic("map --job " + (dir / "other.json").string(), dir), 64, "other.json");
+  std::ofstream(dir / "junk.json") << "{ not json";
+  expect_error(elastic("map --job " + (dir / "junk.json").string(), dir), 65, "junk.json");
+}
+
+TEST(Cli, EverySubcommandHasHelpWithAnExample) {
+  const fs::path dir = test::scratch_dir("cli_help");
+  const CliRun top = elastic("--help", dir);
+  ASSERT_EQ(top.code, 0);
+  for (const char* command : {"map", "sample", "info", "shapes"}) {
+    SCOPED_TRACE(command);
+    EXPECT_NE(top.out.find(command), std::string::npos);
+    const CliRun help = elastic(std::string(command) + " --help", dir);
+    EXPECT_EQ(help.code, 0);
+    EXPECT_NE(help.out.find("Example"), std::string::npos) << help.out;
+  }
+}
+
+}  // namespace
+}  // namespace elastic
