@@ -1,0 +1,367 @@
+// `elastic bench table1`: the paper's Table 1 reproduced. The nine cases (surfaces, regions,
+// particle counts, the paper's seconds) come from a cases file
+// (tools/benchmarks/table1_cases.json); each is mapped --runs times (median seconds), then
+// ElasticPaint, the naive map and the baselines are measured on its grid (compare_methods.h). JSON
+// report and a Markdown results page.
+#include <algorithm>
+#include <chrono>
+#include <ctime>
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <thread>
+
+#include "cli_common.h"
+#include "command.h"
+#include "compare_methods.h"
+#include "elastic/core/atomic_file.h"
+#include "elastic/core/error.h"
+#include "job_file.h"
+#include "map_job.h"
+
+namespace elastic::cli {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct BenchArgs {
+  std::string cases = std::string(ELASTIC_SOURCE_DIR) + "/tools/benchmarks/table1_cases.json";
+  std::string root = ELASTIC_SOURCE_DIR;
+  std::string report;
+  std::string markdown;
+  std::string only;
+  int runs = 3;
+  int threads = 0;
+  bool extra = false;
+  bool quiet = false;
+};
+
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  const size_t n = v.size();
+  return n % 2 == 1 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+std::string cpu_model() {
+  std::ifstream in("/proc/cpuinfo");
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.rfind("model name", 0) == 0) {
+      const auto colon = line.find(':');
+      if (colon != std::string::npos) return line.substr(colon + 2);
+    }
+  }
+  return "unknown";
+}
+
+std::string utc_now() {
+  const std::time_t t = std::time(nullptr);
+  std::tm tm{};
+  gmtime_r(&t, &tm);
+  std::ostringstream s;
+  s << std::put_time(&tm, "%Y-%m-%d %H:%M UTC");
+  return s.str();
+}
+
+std::string fmt(double v, int digits = 4) {
+  std::ostringstream o;
+  o << std::setprecision(digits) << v;
+  return o.str();
+}
+
+// One case of the cases file: {"name", "source", "source_region", "target", "target_region",
+// "particles", "paper_seconds", "paper_springs", "why", "extra"}; paths relative to --root.
+nlohmann::json run_case(const nlohmann::json& c, const BenchArgs& args) {
+  const std::string name = c.at("name").get<std::string>();
+  nlohmann::json out = {{"name", name},
+                        {"source", c.at("source")},
+                        {"target", c.at("target")},
+                        {"source_region", c.value("source_region", "boundary")},
+                        {"target_region", c.value("target_region", "boundary")},
+                        {"paper_particles", c.value("particles", 0)},
+                        {"paper_seconds", c.value("paper_seconds", nlohmann::json())},
+                        {"paper_springs", c.value("paper_springs", nlohmann::json())}};
+  const fs::path source = fs::path(args.root) / c.at("source").get<std::string>();
+  const fs::path target = fs::path(args.root) / c.at("target").get<std::string>();
+  for (const fs::path& p : {source, target}) {
+    if (!fs::exists(p)) {
+      out["skipped"] = p.string() + " is not present";
+      return out;
+    }
+  }
+  MapJob job;
+  job.source = source.string();
+  job.target = target.string();
+  job.source_region = out["source_region"].get<std::string>();
+  job.target_region = out["target_region"].get<std::string>();
+  job.source_anchor = c.value("source_anchor", "");
+  job.target_anchor = c.value("target_anchor", "");
+  job.particles = c.at("particles").get<long>();
+  job.threads = args.threads;
+  job.quiet = true;
+
+  std::vector<double> seconds;
+  std::unique_ptr<MapSession> session;
+  for (int run = 0; run < args.runs; ++run) {
+    if (!args.quiet) std::cerr << "elastic bench: " << name << " run " << run + 1 << "\n";
+    std::unique_ptr<MapSession> s = run_map_job(job);
+    // The map itself (sampling, naive map, relaxation, queryable mapping), not reading the files.
+    seconds.push_back(s->seconds_total - s->seconds_loading);
+    if (!session) session = std::move(s);
+  }
+  if (!args.quiet) std::cerr << "elastic bench: " << name << " baselines\n";
+  const std::vector<MethodMeasurement> methods = compare_methods(*session);
+
+  const MapResult& r = session->result;
+  const SamplingStatistics& st = r.sampling.statistics;
+  out["particles"] = st.particles;
+  out["springs"] = st.normal_springs + st.angular_springs;
+  out["springs_normal"] = st.normal_springs;
+  out["springs_angular"] = st.angular_springs;
+  out["seconds"] = median(seconds);
+  out["seconds_runs"] = seconds;
+  out["iterations"] = r.relaxation.iterations;
+  out["converged"] = r.relaxation.converged;
+  out["reason"] = std::string(to_string(r.relaxation.reason));
+  out["rest_scale"] = r.rest_scale;
+  nlohmann::json& m = out["methods"];
+  m = nlohmann::json::object();
+  for (const MethodMeasurement& x : methods) m[x.name] = measurement_json(x);
+  // ElasticPaint's metrics at the case's top level too, as Table 1 lists them.
+  for (const auto& [key, value] : m["elastic"].items()) {
+    if (key != "seconds" && !out.contains(key)) out[key] = value;
+  }
+  return out;
+}
+
+// ---- the results page ----------------------------------------------------------------------
+
+const std::vector<std::string> kMethods = {"elastic", "naive", "lscm", "arap", "dcm"};
+const std::vector<std::string> kBaselines = {"naive", "lscm", "arap", "dcm"};
+
+struct MetricColumn {
+  std::string key;
+  std::string title;
+  bool lower_is_better_abs = false;  // compare |value - perfect| (e.g. stretch, conformal)
+  double perfect = 0.0;
+};
+const std::vector<MetricColumn> kMetricTables = {
+    {"length_energy", "length_energy (eq. 13 normalised; 0 is perfect)", false, 0.0},
+    {"symmetric_dirichlet", "symmetric_dirichlet (4 is perfect)", true, 4.0},
+    {"angle_error_mean_deg", "angle_error_mean_deg (0 is perfect)", false, 0.0},
+    {"angle_error_max_deg", "angle_error_max_deg (0 is perfect)", false, 0.0},
+    {"stretch_l2", "stretch_l2, forward (1 is perfect)", true, 1.0},
+    {"stretch_linf", "stretch_linf, forward (1 is perfect)", true, 1.0},
+    {"inverse_stretch_l2", "inverse_stretch_l2 (1 is perfect)", true, 1.0},
+    {"inverse_stretch_linf", "inverse_stretch_linf (1 is perfect)", true, 1.0},
+    {"area_distortion", "area_distortion (0 is perfect)", false, 0.0},
+    {"conformal_distortion", "conformal_distortion (1 is perfect)", true, 1.0},
+    {"folds", "folds (0 is perfect)", false, 0.0},
+    {"outside", "outside particles (0 is perfect)", false, 0.0},
+    {"seconds", "seconds on the shared grid", false, 0.0},
+};
+
+bool has_metric(const nlohmann::json& method, const std::string& key) {
+  return method.contains(key) && method[key].is_number();
+}
+
+std::string results_markdown(const nlohmann::json& report) {
+  std::ostringstream s;
+  const nlohmann::json& cases = report["cases"];
+  const nlohmann::json& machine = report["machine"];
+  s << "# Results: the paper's Table 1 reproduced\n\n"
+    << "Generated by `scripts/results` (`elastic bench table1`) on "
+    << machine["date"].get<std::string>() << ": " << machine["cpu"].get<std::string>() << ", "
+    << machine["threads"] << " hardware threads, "
+    << "solver threads " << machine["solver_threads"] << ", median of " << report["runs"]
+    << " runs. Raw numbers: [results/table1.json](results/table1.json). Cases, regions and why: "
+       "`tools/benchmarks/table1_cases.json`. Metric definitions: [metrics.md](metrics.md).\n\n"
+    << "Every method is measured on ElasticPaint's particle grid with the same boundary "
+       "correspondence (arc length from the anchors): `elastic` is ElasticPaint (L-BFGS), `naive` "
+       "its starting map (composed disk maps), `lscm`, `arap`, `dcm` the two-flattening baselines "
+       "(docs/baselines.md). Seconds: the case's `seconds` is the whole map (sampling, naive map, "
+       "relaxation, mapping; files loaded beforehand); a method's seconds are its own work on the "
+       "shared grid. The paper's seconds are from a 1.4 GHz Pentium 4 (2002).\n\n";
+
+  s << "## Table 1\n\n"
+    << "| source → target | particles (paper) | springs (paper) | seconds | paper seconds | "
+       "iterations | folds | length_energy | symmetric_dirichlet |\n"
+    << "|---|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+  for (const auto& c : cases) {
+    s << "| " << c["name"].get<std::string>() << " | ";
+    if (c.contains("skipped")) {
+      s << "skipped: " << c["skipped"].get<std::string>() << " ||||||||\n";
+      continue;
+    }
+    s << c["particles"] << " (" << c["paper_particles"] << ") | " << c["springs"] << " ("
+      << c["paper_springs"] << ") | " << fmt(c["seconds"].get<double>(), 3) << " | "
+      << c["paper_seconds"] << " | " << c["iterations"] << " | " << c["folds"] << " | "
+      << fmt(c["length_energy"].get<double>()) << " | "
+      << fmt(c["symmetric_dirichlet"].get<double>()) << " |\n";
+  }
+
+  s << "\n## Every metric, every method\n\nBold: the best value of the row (closest to perfect).\n";
+  for (const MetricColumn& col : kMetricTables) {
+    s << "\n### " << col.title << "\n\n| case |";
+    for (const auto& m : kMethods) s << ' ' << m << " |";
+    s << "\n|---|";
+    for (size_t k = 0; k < kMethods.size(); ++k) s << "---:|";
+    s << '\n';
+    for (const auto& c : cases) {
+      if (c.contains("skipped")) continue;
+      const nlohmann::json& methods = c["methods"];
+      double best = INFINITY;
+      for (const auto& m : kMethods) {
+        if (methods.contains(m) && has_metric(methods[m], col.key)) {
+          const double v = methods[m][col.key].get<double>();
+          best = std::min(best, col.lower_is_better_abs ? std::abs(v - col.perfect) : v);
+        }
+      }
+      s << "| " << c["name"].get<std::string>() << " |";
+      for (const auto& m : kMethods) {
+        if (!methods.contains(m) || !has_metric(methods[m], col.key)) {
+          s << (methods.contains(m) && methods[m].contains("error") ? " failed |" : " – |");
+          continue;
+        }
+        const double v = methods[m][col.key].get<double>();
+        const double score = col.lower_is_better_abs ? std::abs(v - col.perfect) : v;
+        const std::string text = fmt(v);
+        s << ' ' << (score == best && col.key != "seconds" ? "**" + text + "**" : text) << " |";
+      }
+      s << '\n';
+    }
+  }
+
+  s << "\n## Against LSCM\n\nRatios elastic / lscm (below 1: ElasticPaint is better) and the "
+       "folds and outside particles of both.\n\n"
+    << "| case | length_energy ratio | symmetric_dirichlet − 4 ratio | angle_error_mean ratio | "
+       "folds elastic / lscm | outside lscm |\n|---|---:|---:|---:|---:|---:|\n";
+  for (const auto& c : cases) {
+    if (c.contains("skipped")) continue;
+    const nlohmann::json& e = c["methods"]["elastic"];
+    const nlohmann::json& l = c["methods"]["lscm"];
+    s << "| " << c["name"].get<std::string>() << " | ";
+    if (!has_metric(l, "length_energy")) {
+      s << "lscm failed ||||\n";
+      continue;
+    }
+    const auto ratio = [](double a, double b) { return b > 0.0 ? fmt(a / b, 3) : "–"; };
+    s << ratio(e["length_energy"].get<double>(), l["length_energy"].get<double>()) << " | "
+      << ratio(e["symmetric_dirichlet"].get<double>() - 4.0,
+               l["symmetric_dirichlet"].get<double>() - 4.0)
+      << " | "
+      << ratio(e["angle_error_mean_deg"].get<double>(), l["angle_error_mean_deg"].get<double>())
+      << " | " << e["folds"] << " / " << l["folds"] << " | " << l["outside"] << " |\n";
+  }
+
+  s << "\n## The bar (issue 5)\n\nElasticPaint has zero folds, and its length_energy and "
+       "symmetric_dirichlet are at most those of the best of the other methods (naive, lscm, "
+       "arap, dcm) on the same grid.\n\n"
+    << "| case | folds | length_energy: elastic / best other | symmetric_dirichlet: elastic / "
+       "best other | verdict |\n|---|---:|---|---|---|\n";
+  for (const auto& c : cases) {
+    if (c.contains("skipped")) continue;
+    const nlohmann::json& methods = c["methods"];
+    const nlohmann::json& e = methods["elastic"];
+    const auto best_other = [&](const std::string& key, std::string& who) {
+      double best = INFINITY;
+      for (const auto& m : kBaselines) {
+        if (methods.contains(m) && has_metric(methods[m], key) &&
+            methods[m][key].get<double>() < best) {
+          best = methods[m][key].get<double>();
+          who = m;
+        }
+      }
+      return best;
+    };
+    std::string who_len, who_sd;
+    const double best_len = best_other("length_energy", who_len);
+    const double best_sd = best_other("symmetric_dirichlet", who_sd);
+    const double len = e["length_energy"].get<double>();
+    const double sd = e["symmetric_dirichlet"].get<double>();
+    const bool pass = e["folds"].get<int>() == 0 && len <= best_len && sd <= best_sd;
+    s << "| " << c["name"].get<std::string>() << " | " << e["folds"] << " | " << fmt(len) << " / "
+      << fmt(best_len) << " (" << who_len << ") | " << fmt(sd) << " / " << fmt(best_sd) << " ("
+      << who_sd << ") | " << (pass ? "pass" : "**fail**") << " |\n";
+  }
+  return s.str();
+}
+
+int run_bench(const BenchArgs& args, const CLI::App& sub) {
+  if (args.runs < 1) throw InvalidInputError("--runs", "must be at least 1");
+  nlohmann::json cases_file;
+  {
+    std::ifstream in(args.cases);
+    if (!in) throw IoError(args.cases, "cannot open the cases file");
+    try {
+      in >> cases_file;
+    } catch (const nlohmann::json::exception& e) {
+      throw InvalidInputError(args.cases, std::string("not valid JSON: ") + e.what());
+    }
+  }
+  if (!cases_file.contains("cases") || !cases_file["cases"].is_array()) {
+    throw InvalidInputError(args.cases, "expected an object with a \"cases\" array");
+  }
+  nlohmann::json report;
+  report["job"] = job_of(sub);
+  report["runs"] = args.runs;
+  report["machine"] = {{"cpu", cpu_model()},
+                       {"threads", std::thread::hardware_concurrency()},
+                       {"solver_threads", args.threads},
+                       {"date", utc_now()}};
+  report["cases"] = nlohmann::json::array();
+  for (const auto& c : cases_file["cases"]) {
+    if (c.value("extra", false) && !args.extra) continue;
+    if (!args.only.empty() && c.value("name", "") != args.only) continue;
+    try {
+      report["cases"].push_back(run_case(c, args));
+    } catch (const nlohmann::json::exception& e) {
+      throw InvalidInputError(args.cases, std::string("bad case: ") + e.what());
+    }
+    const nlohmann::json& last = report["cases"].back();
+    if (!args.quiet) {
+      std::cerr << "elastic bench: " << last["name"].get<std::string>()
+                << (last.contains("skipped") ? " skipped: " + last["skipped"].get<std::string>()
+                                             : " done")
+                << '\n';
+    }
+  }
+  write_report(args.report, report);
+  const std::string page = results_markdown(report);
+  if (!args.markdown.empty()) {
+    write_file_atomically(args.markdown, [&](std::ofstream& out) { out << page; });
+  } else {
+    std::cout << page;
+  }
+  return kOk;
+}
+
+}  // namespace
+}  // namespace elastic::cli
+
+ELASTIC_COMMAND("bench", "Benchmarks: `bench table1` reproduces the paper's Table 1",
+                [](CLI::App& sub) {
+                  auto a = std::make_shared<elastic::cli::BenchArgs>();
+                  sub.require_subcommand(1);
+                  CLI::App* table1 = sub.add_subcommand(
+                      "table1", "The paper's nine cases: ElasticPaint and the baselines");
+                  table1->add_option("--cases", a->cases, "Cases file (JSON)");
+                  table1->add_option("--root", a->root,
+                                     "Folder the cases' mesh paths are relative to");
+                  table1->add_option("--report", a->report, "Write the JSON report here");
+                  table1->add_option("--markdown", a->markdown,
+                                     "Write the Markdown results page here (default: stdout)");
+                  table1->add_option("--runs", a->runs, "Runs per case (median seconds)")
+                      ->check(CLI::Range(1, 100));
+                  table1->add_option("--threads", a->threads, "Solver threads (0: all)")
+                      ->check(CLI::Range(0, 1024));
+                  table1->add_option("--only", a->only, "Run only the case with this name");
+                  table1->add_flag("--extra", a->extra,
+                                   "Also run the extra cases (real meshes of ../shared/meshes)");
+                  table1->add_flag("--quiet,-q", a->quiet, "No progress lines on stderr");
+                  return [a, table1] { return elastic::cli::run_bench(*a, *table1); };
+                });
