@@ -321,6 +321,13 @@ int run_bench(const BenchArgs& args, const CLI::App& sub) {
       report["cases"].push_back(run_case(c, args));
     } catch (const nlohmann::json::exception& e) {
       throw InvalidInputError(args.cases, std::string("bad case: ") + e.what());
+    } catch (const Error& e) {
+      // A case that fails (a region that cannot be built, a stage that fails numerically) is a
+      // result to report, not a reason to lose the other cases.
+      report["cases"].push_back({{"name", c.value("name", "")},
+                                 {"source", c.value("source", "")},
+                                 {"target", c.value("target", "")},
+                                 {"skipped", std::string("failed: ") + e.what()}});
     }
     const nlohmann::json& last = report["cases"].back();
     if (!args.quiet) {
