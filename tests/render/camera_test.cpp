@@ -4,8 +4,10 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <vector>
 
 #include "elastic/core/error.h"
 
@@ -98,6 +100,7 @@ TEST(Camera, FrameBoxPutsEveryCornerInsideTheImageAndIsTight) {
         const Camera camera = frame_box(box, view, 40.0, size[0], size[1], fill);
         EXPECT_GT((camera.eye - camera.target).dot(view), 0.0);  // the eye is on the view side
         double widest = 0.0;  // largest |NDC| coordinate over the corners
+        Eigen::AlignedBox2d extent;
         for (int k = 0; k < 8; ++k) {
           const auto p =
               project(camera, box.corner(static_cast<Eigen::AlignedBox3d::CornerType>(k)));
@@ -108,12 +111,50 @@ TEST(Camera, FrameBoxPutsEveryCornerInsideTheImageAndIsTight) {
           EXPECT_LE(std::abs(nx), fill + 1e-9);
           EXPECT_LE(std::abs(ny), fill + 1e-9);
           widest = std::max({widest, std::abs(nx), std::abs(ny)});
+          extent.extend(Eigen::Vector2d(nx, ny));
         }
         // Tight: the eye is as close as it can be, so some corner touches the fill boundary.
         EXPECT_NEAR(widest, fill, 1e-9);
+        // Centred: along the axis that limits the distance, both margins are touched.
+        const int axis = extent.max().x() > fill - 1e-9 ? 0 : 1;
+        EXPECT_NEAR(extent.max()[axis], fill, 1e-9);
+        EXPECT_NEAR(extent.min()[axis], -fill, 1e-9);
       }
     }
   }
+}
+
+TEST(Camera, FramePointsFitsThePointsTightly) {
+  // Points on a unit circle in the plane z = 1 plus the origin, seen obliquely.
+  std::vector<Eigen::Vector3d> points{Eigen::Vector3d::Zero()};
+  for (int i = 0; i < 36; ++i) {
+    const double a = 2.0 * std::numbers::pi * i / 36;
+    points.emplace_back(std::cos(a), std::sin(a), 1.0);
+  }
+  const Eigen::Vector3d view(0.5, -1.0, 1.0);
+  const double fill = 0.9;
+  const Camera camera = frame_points(points, view, 30.0, 80, 60, fill);
+  double widest = 0.0;
+  Eigen::AlignedBox2d extent;
+  for (const Eigen::Vector3d& p : points) {
+    const auto q = project(camera, p);
+    const double nx = 2.0 * q.pixel.x() / 80 - 1.0, ny = 2.0 * q.pixel.y() / 60 - 1.0;
+    EXPECT_LE(std::abs(nx), fill + 1e-9);
+    EXPECT_LE(std::abs(ny), fill + 1e-9);
+    widest = std::max({widest, std::abs(nx), std::abs(ny)});
+    extent.extend(Eigen::Vector2d(nx, ny));
+  }
+  EXPECT_NEAR(widest, fill, 1e-9);
+  // Centred: along the axis that limits the distance, both margins are touched.
+  const int axis = extent.max().x() > fill - 1e-9 ? 0 : 1;
+  EXPECT_NEAR(extent.max()[axis], fill, 1e-9);
+  EXPECT_NEAR(extent.min()[axis], -fill, 1e-9);
+  // Nearer than the box framing, whose corners reach beyond the circle.
+  Eigen::AlignedBox3d box;
+  for (const auto& p : points) box.extend(p);
+  const Camera boxed = frame_box(box, view, 30.0, 80, 60, fill);
+  EXPECT_LT((camera.eye - camera.target).norm(), (boxed.eye - boxed.target).norm());
+  EXPECT_THROW(frame_points({}, view, 30.0, 8, 8), InvalidInputError);
 }
 
 TEST(Camera, FrameBoxAvoidsAnUpVectorAlongTheView) {

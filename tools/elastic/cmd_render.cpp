@@ -140,7 +140,11 @@ int run_render(const RenderArgs& args) {
     }
     view = area.norm() > 0.3 * total ? area : view_from_angles(30.0, 25.0, up);
   }
-  const Camera camera = frame_box(bounding_box(scene), view, args.fov, size.x(), size.y(), 0.9, up);
+  std::vector<Eigen::Vector3d> points;
+  for (const SceneObject& object : scene.objects) {
+    points.insert(points.end(), object.mesh.positions.begin(), object.mesh.positions.end());
+  }
+  const Camera camera = frame_points(points, view, args.fov, size.x(), size.y(), 0.9, up);
 
   RenderOptions options;
   options.samples_per_pixel = args.samples;
@@ -208,8 +212,10 @@ ELASTIC_COMMAND(
           "  elastic render target.obj --wireframe grid.ply --out grid.png   # grid over surface\n"
           "  elastic render distortion.ply --heatmap --out heat.png --view 0,0,1\n"
           "  elastic render --emblem emblem.png --size 256\n"
-          "The camera frames the bounding box of everything drawn; --view points from the scene\n"
-          "towards the eye. The same inputs and --seed give the same PNG on any thread count.");
+          "The camera looks at the centre of everything drawn from as near as it fits (10% "
+          "margin);\n"
+          "--view points from the scene towards the eye. The same inputs and --seed give the same "
+          "PNG on any thread count.");
       return [args, azimuth, elevation] {
         args->angles = azimuth->count() > 0 || elevation->count() > 0;
         return run_render(*args);

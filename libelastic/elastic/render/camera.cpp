@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <string>
 
@@ -12,6 +13,7 @@ namespace elastic {
 namespace {
 
 constexpr double kDegree = std::numbers::pi / 180.0;
+constexpr double kInf = std::numeric_limits<double>::infinity();
 
 void check_fov_and_size(double fov_deg, int width, int height) {
   if (!(fov_deg > 0.0 && fov_deg < 180.0)) {
@@ -106,8 +108,12 @@ Eigen::Vector3d orbit_view(const Eigen::Vector3d& view, double azimuth_deg, doub
   return Eigen::AngleAxisd(elevation_deg * kDegree, axis.normalized()) * turned;
 }
 
-Camera frame_box(const Eigen::AlignedBox3d& box, const Eigen::Vector3d& view_direction,
-                 double fov_deg, int width, int height, double fill, const Eigen::Vector3d& up) {
+namespace {
+
+/// frame_box / frame_points: `points` are what must fit, `box` their bounding box.
+Camera frame(const Eigen::AlignedBox3d& box, const std::vector<Eigen::Vector3d>& points,
+             const Eigen::Vector3d& view_direction, double fov_deg, int width, int height,
+             double fill, const Eigen::Vector3d& up) {
   check_fov_and_size(fov_deg, width, height);
   if (box.isEmpty() || !box.min().allFinite() || !box.max().allFinite()) {
     throw InvalidInputError("camera", "cannot frame an empty or non-finite bounding box");
@@ -135,23 +141,62 @@ Camera frame_box(const Eigen::AlignedBox3d& box, const Eigen::Vector3d& view_dir
   const double tan_h = std::tan(0.5 * fov_deg * kDegree) * fill;
   const double tan_w = tan_h * width / height;
 
-  // With the eye at target + d w, a corner q (relative to the target) is at depth d - q.w and
-  // inside the shrunk frustum iff |q.right| <= (d - q.w) tan_w and |q.up| <= (d - q.w) tan_h.
-  // Each inequality is linear in d, so the smallest admissible d is a maximum over the corners.
+  // Put the eye at e = c + a right + b up + d w (c the box centre) looking along -w. A point q
+  // (relative to c) is at depth d - q.w, and inside the shrunk frustum iff
+  //   |q.right - a| <= (d - q.w) tan_w   and   |q.up - b| <= (d - q.w) tan_h.
+  // For the x part, d >= max_i (s_i + |x_i - a| / t) = max(A - a/t, B + a/t) with s_i = q_i.w,
+  // x_i = q_i.right, t = tan_w, A = max_i (x_i/t + s_i), B = max_i (s_i - x_i/t): a convex
+  // function of a, smallest at a = t (A - B) / 2 with value (A + B) / 2. Likewise for y and b.
+  // The smallest distance is the larger of the two minima, and the sideways offsets (a, b) centre
+  // the picture: on the binding axis the extreme points touch both margins.
   const double diagonal = box.diagonal().norm();
-  double distance = 0.0;
-  for (int k = 0; k < 8; ++k) {
-    const Eigen::Vector3d q =
-        box.corner(static_cast<Eigen::AlignedBox3d::CornerType>(k)) - camera.target;
-    const double toward_eye = q.dot(w);
-    distance = std::max({distance, toward_eye + std::abs(q.dot(right)) / tan_w,
-                         toward_eye + std::abs(q.dot(image_up)) / tan_h,
-                         // keep every corner at least 1% of the diagonal in front of the eye
-                         toward_eye + 0.01 * diagonal});
+  const Eigen::Vector3d centre = box.center();
+  const auto fit_axis = [&](const Eigen::Vector3d& axis, double t, double& offset) {
+    double a_max = -kInf, b_max = -kInf;
+    for (const Eigen::Vector3d& point : points) {
+      const Eigen::Vector3d q = point - centre;
+      const double s = q.dot(w), x = q.dot(axis);
+      a_max = std::max(a_max, x / t + s);
+      b_max = std::max(b_max, s - x / t);
+    }
+    offset = 0.5 * t * (a_max - b_max);
+    return 0.5 * (a_max + b_max);
+  };
+  double offset_x = 0.0, offset_y = 0.0;
+  double distance = std::max(fit_axis(right, tan_w, offset_x), fit_axis(image_up, tan_h, offset_y));
+  for (const Eigen::Vector3d& point : points) {
+    // keep every point at least 1% of the diagonal in front of the eye
+    distance = std::max(distance, (point - centre).dot(w) + 0.01 * diagonal);
   }
+  camera.target = centre + offset_x * right + offset_y * image_up;
   if (!(diagonal > 0.0)) distance = 1.0;
   camera.eye = camera.target + distance * w;
   return camera;
+}
+
+}  // namespace
+
+Camera frame_box(const Eigen::AlignedBox3d& box, const Eigen::Vector3d& view_direction,
+                 double fov_deg, int width, int height, double fill, const Eigen::Vector3d& up) {
+  std::vector<Eigen::Vector3d> corners;
+  if (!box.isEmpty()) {
+    for (int k = 0; k < 8; ++k) {
+      corners.push_back(box.corner(static_cast<Eigen::AlignedBox3d::CornerType>(k)));
+    }
+  }
+  return frame(box, corners, view_direction, fov_deg, width, height, fill, up);
+}
+
+Camera frame_points(const std::vector<Eigen::Vector3d>& points,
+                    const Eigen::Vector3d& view_direction, double fov_deg, int width, int height,
+                    double fill, const Eigen::Vector3d& up) {
+  Eigen::AlignedBox3d box;
+  for (const Eigen::Vector3d& p : points) {
+    if (!p.allFinite()) throw InvalidInputError("camera", "a point to frame is not finite");
+    box.extend(p);
+  }
+  if (points.empty()) throw InvalidInputError("camera", "no points to frame");
+  return frame(box, points, view_direction, fov_deg, width, height, fill, up);
 }
 
 }  // namespace elastic
