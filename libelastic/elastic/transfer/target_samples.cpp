@@ -300,7 +300,11 @@ TargetSamples sample_target(const Region& region, const Mapping& mapping,
     for (size_t i = 0; i < nv; ++i) out.boundary_by_arc_length += out.on_boundary[i] ? 1 : 0;
   }
 
-  // Interior vertices the grid does not cover: nudge towards an adjacent triangle's centroid.
+  const bool relinearise = source_surface != nullptr && options.source_particles.cols() > 0 &&
+                           options.source_particles.cols() == options.target_particles.cols();
+  // Interior vertices the grid does not cover: with particle positions, the grid triangle of an
+  // adjacent covered vertex (the piecewise-linear map extended a little past the grid's edge, see
+  // the header); otherwise the inverse of a point nudged towards an adjacent triangle's centroid.
   std::vector<std::vector<int>> vertex_triangles(nv);
   for (size_t t = 0; t < w.triangles.size(); ++t) {
     for (int k = 0; k < 3; ++k) {
@@ -310,7 +314,21 @@ TargetSamples sample_target(const Region& region, const Mapping& mapping,
   for (size_t i = 0; i < nv; ++i) {
     if (out.sources[i].inside) continue;
     bool found = false;
+    if (relinearise) {
+      for (int t : vertex_triangles[i]) {
+        for (int k = 0; k < 3 && !found; ++k) {
+          const Mapping::Location& other =
+              out.sources[static_cast<size_t>(w.triangles[static_cast<size_t>(t)][k])];
+          if (other.inside && other.triangle >= 0) {
+            out.sources[i] = other;
+            found = true;
+          }
+        }
+        if (found) break;
+      }
+    }
     for (const double f : {0.1, 0.25, 0.5}) {
+      if (found) break;
       for (int t : vertex_triangles[i]) {
         const auto& uv = w.uv[static_cast<size_t>(t)];
         const Eigen::Vector3i& tri = w.triangles[static_cast<size_t>(t)];
@@ -334,6 +352,52 @@ TargetSamples sample_target(const Region& region, const Mapping& mapping,
       ++out.nudged;
     else
       ++out.unresolved;
+  }
+
+  // Piecewise-linear weights in 3D (see the header), Gauss-Newton onto the source surface.
+  if (relinearise) {
+    const auto& grid_triangles = mapping.triangles();
+    const Eigen::Matrix3Xd& sp = options.source_particles;
+    const Eigen::Matrix3Xd& tp = options.target_particles;
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, nv), [&](const tbb::blocked_range<size_t>& r) {
+      for (size_t i = r.begin(); i != r.end(); ++i) {
+        Mapping::Location& loc = out.sources[i];
+        if (!loc.inside || loc.triangle < 0 ||
+            loc.triangle >= static_cast<int>(grid_triangles.size()))
+          continue;
+        const Eigen::Vector3i& tri = grid_triangles[static_cast<size_t>(loc.triangle)];
+        if (tri.maxCoeff() >= tp.cols()) continue;
+        const Eigen::Vector3d t0 = tp.col(tri[0]);
+        const Eigen::Vector3d e1 = tp.col(tri[1]) - t0, e2 = tp.col(tri[2]) - t0;
+        const Eigen::Vector3d d = out.positions[i] - t0;
+        // Normal equations of min |b1 e1 + b2 e2 - d|: the projection onto the triangle's plane.
+        const double g11 = e1.dot(e1), g12 = e1.dot(e2), g22 = e2.dot(e2);
+        const double det = g11 * g22 - g12 * g12;
+        if (!(det > 1e-24 * g11 * g22)) continue;  // degenerate particle triangle: keep the inverse
+        const double r1 = e1.dot(d), r2 = e2.dot(d);
+        const double b1 = (g22 * r1 - g12 * r2) / det, b2 = (g11 * r2 - g12 * r1) / det;
+        const Eigen::Vector3d weights(1.0 - b1 - b2, b1, b2);
+        const Eigen::Vector3d y =
+            weights[0] * sp.col(tri[0]) + weights[1] * sp.col(tri[1]) + weights[2] * sp.col(tri[2]);
+        // Closest point to y from the inverse's answer (already within O(h^2) of it): Gauss-Newton
+        // steps in (u, v), walking across ptex edges.
+        SurfacePoint p = loc.point;
+        for (int iteration = 0; iteration < 6; ++iteration) {
+          const SurfaceDerivatives der = source_surface->derivatives(p);
+          const Eigen::Vector3d residual = y - der.position;
+          const double a11 = der.du.dot(der.du), a12 = der.du.dot(der.dv), a22 = der.dv.dot(der.dv);
+          const double adet = a11 * a22 - a12 * a12;
+          if (!(adet > 0.0)) break;
+          const double q1 = der.du.dot(residual), q2 = der.dv.dot(residual);
+          const Eigen::Vector2d step((a22 * q1 - a12 * q2) / adet, (a11 * q2 - a12 * q1) / adet);
+          p = source_surface->walk(p, step);
+          if (step.norm() < 1e-14) break;
+        }
+        loc.point = p;
+        loc.position = source_surface->position(p);
+        loc.barycentric = weights;
+      }
+    });
   }
 
   // Boundary loop of the refined mesh: boundary vertices in loop order.

@@ -27,10 +27,23 @@
 ///    relaxed grid's boundary chords cut small slivers off the disk, so boundary vertices between
 ///    particles are typically "outside" for the grid; with `source_region` every boundary vertex
 ///    is resolved this way, for consistency.
-///  - interior vertices (in such a sliver, or outside by round-off) take the inverse of a point
-///    nudged towards the centroid of an adjacent triangle (10%, 25%, then 50% of the way, in the
-///    ptex face of that triangle): an error of at most half an edge, counted in `nudged`.
+///  - interior vertices (in such a sliver, or outside by round-off): when the particles' positions
+///    are given (see below), they take the grid triangle of an adjacent covered vertex, whose
+///    3D-linear map extends a little past the grid's edge; otherwise the inverse of a point nudged
+///    towards the centroid of an adjacent triangle (10%, 25%, then 50% of the way, in the ptex face
+///    of that triangle), an error of at most half an edge. Both are counted in `nudged`.
 /// What still has no source keeps `inside = false` and is counted in `unresolved`.
+///
+/// Piecewise-linear in 3D: Mapping::inverse takes its weights in the grid triangle from the disk
+/// maps' coordinates, which are not affine over a grid triangle, so between particles it deviates
+/// from the particles' piecewise-linear map by O(h^2) times the disk maps' second derivatives (up
+/// to a few percent of the spacing near the corners of a rectangle). When the particles' positions
+/// are given, the weights are recomputed as the barycentric coordinates of the vertex's projection
+/// onto the plane of the target particle triangle the inverse located (extrapolating slightly when
+/// the disk maps located a neighbour), applied to the source particles, and the resulting point is
+/// put on the source surface by Gauss-Newton steps from the inverse's answer (closest point). Then
+/// a map that is rigid at the particles between flat regions is rigid everywhere, and a colour
+/// field linear on a flat source arrives linearly interpolated between particles.
 ///
 /// The refinement and the inverse queries run in parallel (TBB); the result does not depend on the
 /// number of threads.
@@ -59,6 +72,12 @@ struct TargetSamplingOptions {
   /// The mapped source region (the one the mapping was built from): resolves boundary vertices by
   /// arc length on its boundary curve. Null: boundary vertices use the inverse like the others.
   const Region* source_region = nullptr;
+  /// Particle positions, 3 x #P, on the source (MapResult::sampling.grid.source_positions()) and
+  /// on the target (MapResult::relaxation.positions). When both are given and `source_region` is
+  /// set, each inverse is made piecewise linear in 3D (see the file comment). Empty: the
+  /// mapping's own weights.
+  Eigen::Matrix3Xd source_particles;
+  Eigen::Matrix3Xd target_particles;
   /// Name used in error messages.
   std::string name = "target";
 };

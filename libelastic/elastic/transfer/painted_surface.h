@@ -1,0 +1,110 @@
+#pragma once
+/// \file
+/// The painted target: the whole target limit surface as one triangle mesh, the region refined for
+/// transfer and the rest kept, and the mesh outputs built on it: the textured decal (OBJ + MTL +
+/// PNG) and the per-vertex colour mesh (PLY).
+///
+/// Design: our target geometry is the limit surface, not the control mesh, so the output is the
+/// target's limit tessellation (`resolution` segments per control edge, limit_tessellation.h) cut
+/// exactly along the region's boundary curve (regions/surface_partition.h). Outside the region the
+/// triangles keep the control mesh's texture coordinates interpolated at their corners
+/// (regions/texture_coordinates.h) and their control face's material; inside, the re-cut region is
+/// refined and mapped to the source by sample_target (target_samples.h). Both sides share the
+/// boundary vertices; an outside triangle that borders a refined boundary segment is fanned from
+/// its (u, v) centroid (a new limit point) through the segment's new vertices, so the mesh has no
+/// T-junctions and is watertight wherever the target tessellation is.
+///
+/// Colour is carried per vertex of the refined inside: the source point of each vertex (its
+/// `Mapping::Location`) gives the colour (ColorSource::color) and, for a texture, the texture
+/// coordinate into the source image (ColorSource::texcoord). Between vertices both are linear over
+/// the refined triangles: texture coordinates per corner (the decal, exact to the source image's
+/// resolution as far as the map is linear over a refined triangle), colours per vertex (the PLY,
+/// resolution = the refinement's).
+
+#include <Eigen/Core>
+#include <array>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "elastic/mesh/polygon_mesh.h"
+#include "elastic/transfer/color_source.h"
+#include "elastic/transfer/target_samples.h"
+
+namespace elastic {
+
+struct PaintedSurfaceOptions {
+  /// Target tessellation: segments per control edge (TessellationOptions::resolution), 1..1024.
+  int resolution = 8;
+  /// Refinement of the region and how its vertices find their source (target_samples.h). Its
+  /// `source_region` should be set to the mapped source region.
+  TargetSamplingOptions sampling;
+  /// Snap of curve points when cutting the tessellation (PartitionOptions::snap).
+  double snap = 1e-6;
+  /// Name used in error messages.
+  std::string name = "target";
+};
+
+struct PaintedSurface {
+  const LimitSurface* surface = nullptr;  ///< the target (not owned)
+  /// The refined region with its vertices' source locations. Its vertex j is vertex
+  /// `sample_vertex_index[j]` of this mesh.
+  TargetSamples samples;
+  std::vector<int> sample_vertex_index;  ///< #samples.V index into positions
+
+  std::vector<Eigen::Vector3d> positions;  ///< #V limit positions (both sides)
+  std::vector<SurfacePoint> points;        ///< #V target surface points
+  std::vector<int> vertex_sample;  ///< #V index into samples' vertices, -1 outside the region
+  std::vector<Eigen::Vector3i> triangles;  ///< #T counter-clockwise; outside ones first
+  std::vector<int> triangle_face;          ///< #T ptex face of each triangle
+  std::vector<std::array<Eigen::Vector2d, 3>> triangle_uv;  ///< #T corners' (u,v) in that face
+  std::vector<char> triangle_inside;                        ///< #T 1 for region triangles
+
+  int num_vertices() const { return static_cast<int>(positions.size()); }
+  int num_triangles() const { return static_cast<int>(triangles.size()); }
+};
+
+/// Tessellates the target, cuts it along `target_region` (which must lie on `target` and be the
+/// region `mapping` was built to), refines the inside and maps it back (sample_target).
+/// \throws InvalidInputError / NumericalError from partition_surface and sample_target, naming
+///         options.name.
+PaintedSurface paint_surface(const LimitSurface& target, const Region& target_region,
+                             const Mapping& mapping, const PaintedSurfaceOptions& options = {});
+
+/// The source colour at every vertex of the refined region (ColorSource::color at
+/// samples.sources[i].point; `missing` where a vertex has no source).
+std::vector<Eigen::Vector4f> transfer_colors(const TargetSamples& samples,
+                                             const ColorSource& source,
+                                             const Eigen::Vector4f& missing = {1, 0, 1, 1});
+
+struct DecalOptions {
+  /// Name of the new material of the region's faces.
+  std::string material_name = "decal";
+  /// The image file the decal material's map_Kd names (written by write_decal; any path here is
+  /// stored in the mesh as given).
+  std::filesystem::path texture_path;
+};
+
+/// The decal mesh: positions of `painted`; outside faces with the target's interpolated texture
+/// coordinates (the single coordinate (0,0) when the target has none) and their control face's
+/// material (copied from the target); region faces with the source's texture coordinates at
+/// their corners and a new material `material_name` whose map_Kd is `texture_path`.
+/// \throws InvalidInputError naming the source when `source` is not a Texture source.
+PolygonMesh make_decal_mesh(const PaintedSurface& painted, const ColorSource& source,
+                            const DecalOptions& options = {});
+
+/// Writes the decal: `obj` (+ the .mtl beside it, same stem) and the source image as
+/// "<stem>_decal.png" beside it, all atomically. Returns the written paths (obj, mtl, png).
+/// \throws IoError when a file cannot be written; InvalidInputError as make_decal_mesh.
+std::vector<std::filesystem::path> write_decal(const std::filesystem::path& obj,
+                                               const PaintedSurface& painted,
+                                               const ColorSource& source,
+                                               const std::string& material_name = "decal");
+
+/// The per-vertex colour mesh: region vertices (boundary included) carry the source colour,
+/// the others the target's own vertex colours interpolated (control_vertex_weights) or, when it
+/// has none, `outside`.
+PolygonMesh make_colored_mesh(const PaintedSurface& painted, const ColorSource& source,
+                              const Eigen::Vector3f& outside = {0.5f, 0.5f, 0.5f});
+
+}  // namespace elastic
