@@ -8,10 +8,13 @@
 ///
 /// - Lscm: least-squares conformal map (Lévy et al. 2002), free boundary, two boundary vertices
 ///   pinned at the correspondence parameters s = 0 and s = 0.5.
-/// - Arap: as-rigid-as-possible (Liu et al. 2008), free boundary, LSCM initialisation.
+/// - Arap: as-rigid-as-possible (Liu et al. 2008, local/global), free boundary, CGAL's mean-value
+///   initialisation; CGAL post-processes flipped results.
 /// - Dcm: discrete conformal map (Desbrun et al. 2002; cotangent weights) with the boundary fixed
-/// on
-///   a circle by arc length (a convex border is required for a bijective map).
+///   on the unit circle at angle 2 pi s (a fixed convex border, as the method needs).
+///
+/// Every flattening is scaled to its region's 3D area, so `alignment_rms` is in surface units and
+/// `alignment_scale` is about the ratio of the target's to the source's size.
 ///
 /// The boundary correspondence is the normalised arc length s from each region's anchor (the one
 /// ElasticPaint uses, see SurfaceCurve). Boundary particles are placed exactly on the target curve
