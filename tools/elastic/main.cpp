@@ -33,7 +33,11 @@ int main(int argc, char** argv) {
     sub->option_defaults()->always_capture_default();
     auto runner = std::make_shared<std::function<int()>>();
     *runner = command.setup(*sub);
-    if (command.name != "version") add_job_option(*sub);
+    if (command.name != "version") {
+      add_job_option(*sub);
+      // Nested subcommands (e.g. `bench table1`) take a job file too.
+      for (CLI::App* nested : sub->get_subcommands({})) add_job_option(*nested);
+    }
     sub->callback([runner, sub, &run, &chosen] {
       run = *runner;
       chosen = sub;
@@ -48,7 +52,12 @@ int main(int argc, char** argv) {
   }
 
   try {
-    if (chosen != nullptr) apply_job_file(*chosen);
+    if (chosen != nullptr) {
+      // The job file belongs to the innermost subcommand given (`bench table1 --job F`).
+      CLI::App* leaf = chosen;
+      while (!leaf->get_subcommands().empty()) leaf = leaf->get_subcommands().front();
+      apply_job_file(*leaf);
+    }
     return run ? run() : kUsage;
   } catch (const UsageError& e) {
     std::cerr << "elastic: " << e.what() << "\nRun with --help for more information.\n";
