@@ -21,6 +21,7 @@ MapResult map_regions(const SurfaceProjector& source, const Region& source_regio
   if (target_region.surface != &target.surface()) {
     throw InvalidInputError("target region", "does not lie on the target surface");
   }
+  if (options.subdivisions < 0) throw InvalidInputError("subdivisions", "must be 0 or more");
   auto stage = [&](std::string_view name) {
     if (!report_progress(options.progress, {.stage = name})) {
       throw Error("map", "cancelled during " + std::string(name));
@@ -70,8 +71,33 @@ MapResult map_regions(const SurfaceProjector& source, const Region& source_regio
         result.naive.positions.col(grid.boundary_loop[k]);
   }
   result.relaxation = relax(problem, options.relaxation);
+  result.sampled_particles = grid.num_particles();
 
-  // 5. The queryable mapping.
+  // 5. Subdivision (end of §4.3): refine the grid on the source and the map on the target, relax
+  // briefly after each level. Everything returned then describes the refined grid.
+  if (options.subdivisions > 0) {
+    start = std::chrono::steady_clock::now();
+    RefineMapOptions refine;
+    refine.levels = options.subdivisions;
+    refine.relaxation = options.relaxation;
+    refine.relaxation.solver = SolverKind::Fast;
+    refine.relaxation.max_iterations = options.subdivision_iterations;
+    refine.progress = options.progress;
+    refine.name = options.sampling.layout.name;
+    RefineMapResult refined = refine_map(grid, result.relaxation, source, *result.source_disk,
+                                         target, *result.target_disk, refine);
+    result.coarse_relaxation = std::move(result.relaxation);
+    result.relaxation = std::move(refined.relaxation);
+    result.sampling.grid = std::move(refined.grid);
+    result.sampling.statistics = measure_sampling(result.sampling.grid, source.surface());
+    result.naive = naive_map(result.sampling.grid, *result.source_disk, *result.target_disk);
+    result.subdivisions = options.subdivisions;
+    result.subdivision_levels = std::move(refined.levels);
+    result.subdivision_iterations = refined.iterations;
+    result.seconds_subdivision = seconds_since(start);
+  }
+
+  // 6. The queryable mapping.
   stage("mapping");
   start = std::chrono::steady_clock::now();
   result.mapping = Mapping(grid, source, *result.source_disk, target, *result.target_disk,

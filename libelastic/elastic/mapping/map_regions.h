@@ -21,6 +21,7 @@
 #include "elastic/core/progress.h"
 #include "elastic/mapping/initial_map.h"
 #include "elastic/mapping/mapping.h"
+#include "elastic/mapping/refine_map.h"
 #include "elastic/regions/region.h"
 #include "elastic/sampling/sample_region.h"
 #include "elastic/solvers/relaxation.h"
@@ -35,18 +36,42 @@ struct MapOptions {
   RelaxationOptions relaxation;
   /// How rest lengths are scaled between source and target sizes (particles/spring_energy.h).
   RestScale rest_scale = RestScale::Boundary;
-  /// Called between stages ("sample", "naive map", "relax", "mapping"); return false to cancel.
+  /// Levels of 1-to-4 grid subdivision after the relaxation (end of §4.3, mapping/refine_map.h),
+  /// each followed by a brief relaxation; every level multiplies the particles by about 4. 0: none.
+  int subdivisions = 0;
+  /// L-BFGS iteration budget of each level's brief relaxation (fast solver; the other fields of
+  /// `relaxation` are used as given).
+  long subdivision_iterations = 200;
+  /// Called between stages ("sample", "naive map", "relax", "subdivide", "relax refined",
+  /// "mapping"); return false to cancel.
   ProgressCallback progress;
 };
 
+/// With `subdivisions` > 0, `sampling.grid` (and `sampling.statistics`), `naive`, `relaxation` and
+/// `mapping` all describe the final refined grid; the sampled grid's own relaxation is kept in
+/// `coarse_relaxation`.
 struct MapResult {
-  SampleRegionResult sampling;    ///< the particle grid on the source and its statistics
-  InitialMap naive;               ///< the starting placement on the target (the naive map)
+  SampleRegionResult sampling;  ///< the particle grid on the source and its statistics
+  /// The naive map of the grid (recomputed for the refined grid after subdivision, so it has one
+  /// entry per particle of sampling.grid; the relaxation started from the sampled grid's).
+  InitialMap naive;
   RelaxationResult relaxation;    ///< the relaxed placement and the solver's report
   double rest_scale = 1.0;        ///< sigma actually used
   double seconds_sampling = 0.0;  ///< source sampling (layout + adaptive sampling + springs)
   double seconds_naive = 0.0;     ///< disk maps of both regions + naive placement
   double seconds_mapping = 0.0;   ///< building the queryable mapping
+  // Subdivision (MapOptions::subdivisions > 0; otherwise these stay empty / equal the sampled
+  // grid).
+  int sampled_particles = 0;  ///< particles of the sampled grid, before subdivision
+  int subdivisions = 0;       ///< subdivision levels run
+  /// Per level: particles before/after, the brief relaxation's iterations, convergence, folds,
+  /// energies and seconds.
+  std::vector<RefinementLevel> subdivision_levels;
+  long subdivision_iterations = 0;   ///< L-BFGS iterations summed over the levels
+  double seconds_subdivision = 0.0;  ///< all levels: subdivision, placement, brief relaxations
+  /// The main relaxation of the sampled grid when subdivisions > 0 (then `relaxation` is the last
+  /// level's); default-constructed (no positions) when subdivisions is 0.
+  RelaxationResult coarse_relaxation;
   /// Disk maps of the two regions (owned here so `mapping` can reference them).
   std::unique_ptr<RegionDiskMap> source_disk;
   std::unique_ptr<RegionDiskMap> target_disk;

@@ -1,0 +1,158 @@
+#include "elastic/mapping/refine_map.h"
+
+#include <chrono>
+#include <limits>
+#include <span>
+
+#include "elastic/core/error.h"
+
+namespace elastic {
+
+namespace {
+
+double seconds_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+// The boundary parameter of every particle (-1 inside).
+std::vector<double> particle_parameters(const ParticleGrid& grid) {
+  std::vector<double> s(static_cast<size_t>(grid.num_particles()), -1.0);
+  for (size_t k = 0; k < grid.boundary_loop.size(); ++k) {
+    s[static_cast<size_t>(grid.boundary_loop[k])] = grid.boundary_parameter[k];
+  }
+  return s;
+}
+
+}  // namespace
+
+RefineMapResult refine_map(const ParticleGrid& grid, const RelaxationResult& relaxed,
+                           const SurfaceProjector& source, const RegionDiskMap& source_disk,
+                           const SurfaceProjector& target, const RegionDiskMap& target_disk,
+                           const RefineMapOptions& options) {
+  const std::string& name = options.name;
+  const int np = grid.num_particles();
+  if (relaxed.positions.cols() != np || static_cast<int>(relaxed.points.size()) != np) {
+    throw InvalidInputError(name, "relaxed placement has " +
+                                      std::to_string(relaxed.positions.cols()) + " positions for " +
+                                      std::to_string(np) + " particles");
+  }
+  if (options.levels < 0) throw InvalidInputError(name, "negative number of subdivision levels");
+  if (options.relaxation.solver != SolverKind::Fast) {
+    throw InvalidInputError(name, "refinement relaxes with the fast solver only");
+  }
+  auto stage = [&](std::string_view what, int level) {
+    if (!report_progress(options.progress,
+                         {.stage = what, .iteration = level, .total = options.levels})) {
+      throw Error(name, "cancelled during " + std::string(what));
+    }
+  };
+  const auto start_all = std::chrono::steady_clock::now();
+
+  RefineMapResult result;
+  result.grid = grid;
+  result.relaxation = relaxed;
+  const LimitSurface& target_surface = target.surface();
+
+  for (int level = 0; level < options.levels; ++level) {
+    stage("subdivide", level);
+    auto start = std::chrono::steady_clock::now();
+    const ParticleGrid& coarse = result.grid;
+    const int nc = coarse.num_particles();
+
+    // 1. Subdivide on the source, interior particles averaged on the source disk. A particle the
+    //    disk map cannot place gets NaN coordinates, so its children fall back to the magnet.
+    GridSubdivisionOptions subdivision;
+    subdivision.name = name;
+    subdivision.plane_coordinates.resize(static_cast<size_t>(nc));
+    for (int i = 0; i < nc; ++i) {
+      Eigen::Vector2d disk;
+      if (!source_disk.to_disk(coarse.source_points[static_cast<size_t>(i)], disk)) {
+        disk.setConstant(std::numeric_limits<double>::quiet_NaN());
+      }
+      subdivision.plane_coordinates[static_cast<size_t>(i)] = disk;
+    }
+    subdivision.plane_to_surface = [&](const Eigen::Vector2d& disk, SurfacePoint& p) {
+      return source_disk.from_disk(disk, p);
+    };
+    subdivision.boundary_point = [&](double s) { return source_disk.boundary_point(s); };
+    GridSubdivisionResult refined =
+        subdivide_grid(coarse, source, source_disk.region().boundary_curve(), subdivision);
+    const int nf = refined.grid.num_particles();
+
+    // 2. Target placement (file comment).
+    const std::vector<double> parameter = particle_parameters(refined.grid);
+    RelaxationProblem problem;
+    problem.target = &target;
+    problem.rest_scale = relaxed.rest_scale;
+    problem.rest_scale_mode = relaxed.rest_scale_mode;
+    problem.initial_positions.resize(3, nf);
+    problem.initial_points.resize(static_cast<size_t>(nf));
+    std::vector<int> magnet;
+    for (int p = 0; p < nf; ++p) {
+      const SubdivisionParents& parents = refined.parents[static_cast<size_t>(p)];
+      if (parents.count == 1) {
+        problem.initial_positions.col(p) = result.relaxation.positions.col(parents.parent[0]);
+        problem.initial_points[static_cast<size_t>(p)] =
+            result.relaxation.points[static_cast<size_t>(parents.parent[0])];
+      } else if (parameter[static_cast<size_t>(p)] >= 0.0) {
+        const SurfacePoint q = target_disk.boundary_point(parameter[static_cast<size_t>(p)]);
+        problem.initial_points[static_cast<size_t>(p)] = q;
+        problem.initial_positions.col(p) = target_surface.position(q);
+      } else {
+        magnet.push_back(p);
+      }
+    }
+    std::vector<Eigen::Vector3d> queries(magnet.size());
+    std::vector<SurfacePoint> hints(magnet.size());
+    for (size_t k = 0; k < magnet.size(); ++k) {
+      const SubdivisionParents& parents = refined.parents[static_cast<size_t>(magnet[k])];
+      Eigen::Vector3d x = Eigen::Vector3d::Zero();
+      for (int j = 0; j < parents.count; ++j) {
+        x += result.relaxation.positions.col(parents.parent[static_cast<size_t>(j)]);
+      }
+      queries[k] = x / parents.count;
+      hints[k] = result.relaxation.points[static_cast<size_t>(parents.parent[0])];
+    }
+    std::vector<ClosestPoint> answers(magnet.size());
+    target.closest(std::span<const Eigen::Vector3d>(queries), std::span<ClosestPoint>(answers),
+                   std::span<const SurfacePoint>(hints));
+    for (size_t k = 0; k < magnet.size(); ++k) {
+      problem.initial_positions.col(magnet[k]) = answers[k].position;
+      problem.initial_points[static_cast<size_t>(magnet[k])] = answers[k].point;
+    }
+    const std::vector<int>& loop = refined.grid.boundary_loop;
+    problem.boundary_targets.resize(3, static_cast<Eigen::Index>(loop.size()));
+    for (size_t k = 0; k < loop.size(); ++k) {
+      problem.boundary_targets.col(static_cast<Eigen::Index>(k)) =
+          problem.initial_positions.col(loop[k]);
+    }
+    RefinementLevel report;
+    report.particles_before = nc;
+    report.particles_after = nf;
+    report.faces_after = static_cast<int>(refined.grid.mesh.n_faces());
+    report.boundary_particles = static_cast<int>(loop.size());
+    report.source_magnet_placements = refined.magnet_placements;
+    report.seconds_subdivide = seconds_since(start);
+
+    // 3. Brief relaxation of the refined grid.
+    stage("relax refined", level);
+    start = std::chrono::steady_clock::now();
+    result.grid = std::move(refined.grid);
+    problem.grid = &result.grid;
+    result.relaxation = relax(problem, options.relaxation);
+    report.seconds_relax = seconds_since(start);
+    report.iterations = result.relaxation.iterations;
+    report.converged = result.relaxation.converged;
+    report.reason = result.relaxation.reason;
+    report.initial_folded_faces = result.relaxation.initial_folded_faces;
+    report.folded_faces = result.relaxation.folded_faces;
+    report.initial_energy = result.relaxation.initial_energy;
+    report.energy = result.relaxation.length_energy + result.relaxation.angular_energy;
+    result.iterations += report.iterations;
+    result.levels.push_back(report);
+  }
+  result.seconds = seconds_since(start_all);
+  return result;
+}
+
+}  // namespace elastic
