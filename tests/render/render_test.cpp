@@ -241,6 +241,31 @@ TEST(Render, WireframeDarkensTheEdgesOfAGridLyingOnASurface) {
   }
 }
 
+TEST(Render, AGridJustUnderASurfaceShowsAndOneFarBelowIsHidden) {
+  // A grid 0.5% of the scene diagonal (2.83) under a white plane is within the default 1%
+  // tolerance; one 0.3 units under (10%) is hidden by the plane.
+  const auto luminance_on_line = [](double depth) {
+    Scene scene;
+    SceneObject plane{grid_plane(1), {}};
+    plane.look.colors = ColorSource::Plain;
+    plane.look.plain_color = {1.0f, 1.0f, 1.0f};
+    SceneObject grid{grid_plane(4), {}};
+    for (Eigen::Vector3d& p : grid.mesh.positions) p.z() = -depth;
+    grid.look.surface = false;
+    grid.look.wireframe = true;
+    grid.look.wire_width_px = 2.0;
+    grid.look.wire_color = {0.0f, 0.0f, 0.0f};
+    scene.objects = {plane, grid};
+    const Camera camera = head_on(64);
+    const Image image = render(scene, camera);
+    const Eigen::Vector2d p = project(camera, {0.0, 0.25, 0.0}).pixel;  // on the line x = 0
+    const Eigen::Vector4f c = image.at(static_cast<int>(p.x()), static_cast<int>(p.y()));
+    return (c.x() + c.y() + c.z()) / 3.0f;
+  };
+  EXPECT_LT(luminance_on_line(0.014), 0.1f);  // the black wire
+  EXPECT_GT(luminance_on_line(0.3), 0.8f);    // the white plane
+}
+
 TEST(Render, VertexColoursAreInterpolated) {
   Scene scene;
   SceneObject plane{grid_plane(1), {}};

@@ -92,11 +92,6 @@ struct PreparedObject {
   double wire_radius = 0.0;
 };
 
-struct GeometryInfo {
-  int object = -1;
-  bool curve = false;
-};
-
 std::string object_name(size_t k) {
   return "object " + std::to_string(k);
 }
@@ -258,7 +253,11 @@ Eigen::Vector3f to_float(const Eigen::Vector3d& v) {
 class Tracer {
  public:
   Tracer(const Scene& scene, const Camera& camera, const RenderOptions& options)
-      : camera_(camera), options_(options), frame_(camera_frame(camera)), scene_(device_.handle) {
+      : camera_(camera),
+        options_(options),
+        frame_(camera_frame(camera)),
+        surfaces_(device_.handle),
+        wires_(device_.handle) {
     const Eigen::AlignedBox3d box = bounding_box(scene);
     if (!box.isEmpty()) shift_ = box.center();
     diagonal_ = box.isEmpty() ? 1.0 : std::max(box.diagonal().norm(), 1e-300);
@@ -288,32 +287,44 @@ class Tracer {
       }
       if (look.wireframe) add_curves(static_cast<int>(k));
     }
-    rtcCommitScene(scene_.handle);
+    rtcCommitScene(surfaces_.handle);
+    rtcCommitScene(wires_.handle);
     check_device(device_.handle, "build the scene");
+    wire_slack_ = static_cast<float>(options.wire_depth_tolerance * diagonal_);
   }
 
   /// Premultiplied RGBA seen along the ray from the eye through continuous pixel (px, py).
   Eigen::Vector4f trace(double px, double py, SampleRandom& random) const {
     const Eigen::Vector3d direction = camera_ray_direction(camera_, frame_, px, py);
-    RTCRayHit query =
-        make_ray(camera_.eye - shift_, direction, 0.0, std::numeric_limits<float>::infinity());
+    const Eigen::Vector3d origin = camera_.eye - shift_;
+    const Eigen::Vector3d view = -direction;  // towards the eye
+    RTCRayHit query = make_ray(origin, direction, 0.0, std::numeric_limits<float>::infinity());
     RTCIntersectContext context;
     rtcInitIntersectContext(&context);
-    rtcIntersect1(scene_.handle, &context, &query);
-    if (query.hit.geomID == RTC_INVALID_GEOMETRY_ID) return background(py);
-    const GeometryInfo& info = geometries_[query.hit.geomID];
-    const PreparedObject& prepared = prepared_[static_cast<size_t>(info.object)];
-    const Eigen::Vector3d view = -direction;  // towards the eye
+    rtcIntersect1(surfaces_.handle, &context, &query);
+    // Wires win over the surface seen when they are in front of it or at most `wire_slack_`
+    // behind it along the ray (a grid on the limit surface lies just under the control mesh).
+    RTCRayHit wire = make_ray(origin, direction, 0.0,
+                              query.hit.geomID == RTC_INVALID_GEOMETRY_ID
+                                  ? std::numeric_limits<float>::infinity()
+                                  : query.ray.tfar + wire_slack_);
+    rtcInitIntersectContext(&context);
+    rtcIntersect1(wires_.handle, &context, &wire);
 
-    if (info.curve) {
-      Eigen::Vector3d n(query.hit.Ng_x, query.hit.Ng_y, query.hit.Ng_z);
+    if (wire.hit.geomID != RTC_INVALID_GEOMETRY_ID) {
+      const PreparedObject& prepared =
+          prepared_[static_cast<size_t>(wire_objects_[wire.hit.geomID])];
+      Eigen::Vector3d n(wire.hit.Ng_x, wire.hit.Ng_y, wire.hit.Ng_z);
       n = n.norm() > 0.0 ? Eigen::Vector3d(n.normalized()) : view;
       if (n.dot(view) < 0.0) n = -n;
       const Eigen::Vector3f c = prepared.object->look.wire_color;
       const auto light = static_cast<float>(lighting(n, 1.0));
       return {c.x() * light, c.y() * light, c.z() * light, 1.0f};
     }
+    if (query.hit.geomID == RTC_INVALID_GEOMETRY_ID) return background(py);
 
+    const PreparedObject& prepared =
+        prepared_[static_cast<size_t>(surface_objects_[query.hit.geomID])];
     const PolygonMesh& mesh = prepared.object->mesh;
     const std::array<int, 3>& corners = prepared.triangle_corners[query.hit.primID];
     const int face = prepared.triangle_face[query.hit.primID];
@@ -399,7 +410,7 @@ class Tracer {
       RTCRay ray = make_ray(origin, d, 0.0, radius).ray;
       RTCIntersectContext context;
       rtcInitIntersectContext(&context);
-      rtcOccluded1(scene_.handle, &context, &ray);
+      rtcOccluded1(surfaces_.handle, &context, &ray);  // wires cast no occlusion
       // Embree sets tfar to -inf when the ray is blocked.
       if (ray.tfar >= 0.0f) ++open;
     }
@@ -445,10 +456,11 @@ class Tracer {
 
   void attach(RTCGeometry geometry, int object, bool curve) {
     rtcCommitGeometry(geometry);
-    const unsigned id = rtcAttachGeometry(scene_.handle, geometry);
+    const unsigned id = rtcAttachGeometry((curve ? wires_ : surfaces_).handle, geometry);
     rtcReleaseGeometry(geometry);
-    if (geometries_.size() <= id) geometries_.resize(id + 1);
-    geometries_[id] = {object, curve};
+    std::vector<int>& objects = curve ? wire_objects_ : surface_objects_;
+    if (objects.size() <= id) objects.resize(id + 1, -1);
+    objects[id] = object;
   }
 
   void add_triangles(int k) {
@@ -524,12 +536,15 @@ class Tracer {
   const Camera& camera_;
   const RenderOptions& options_;
   CameraFrame frame_;
-  EmbreeScene scene_;
+  EmbreeScene surfaces_;  // the objects' triangles
+  EmbreeScene wires_;     // the wireframe tubes
+  float wire_slack_ = 0.0f;
   Eigen::Vector3d shift_ = Eigen::Vector3d::Zero();
   double diagonal_ = 1.0;
   Eigen::Vector3d key_ = Eigen::Vector3d::UnitZ();
   std::vector<PreparedObject> prepared_;
-  std::vector<GeometryInfo> geometries_;
+  std::vector<int> surface_objects_;  // object of each geometry ID in surfaces_
+  std::vector<int> wire_objects_;     // object of each geometry ID in wires_
 };
 
 void check_options(const RenderOptions& options) {
@@ -550,6 +565,9 @@ void check_options(const RenderOptions& options) {
   if (!std::isfinite(options.ambient) || !std::isfinite(options.headlight) ||
       !std::isfinite(options.key_light)) {
     bad("light intensities must be finite");
+  }
+  if (!(options.wire_depth_tolerance >= 0.0) || !std::isfinite(options.wire_depth_tolerance)) {
+    bad("wire depth tolerance must be a finite number >= 0");
   }
   if (options.threads < 0) bad("thread count " + std::to_string(options.threads) + " is negative");
 }

@@ -11,12 +11,11 @@
 /// - Optionally the object's polygon edges (not the fan diagonals) as a wireframe overlay. Edges
 /// are
 ///   Embree round linear curves (tubes) whose radius is chosen so that they are `wire_width_px`
-///   pixels wide at the distance of the camera target. Being geometry, they are hidden by surfaces
-///   in front of them and visible where they rise above a surface they lie on: an edge polygon
-///   whose vertices lie on a smooth surface (the particle grid) dips below the surface by its
-///   sagitta, so the width must exceed twice the sagitta for a line to show along its whole length;
-///   the default width does for grids much finer than the curvature radius. An object with `surface
-///   = false` shows only its edges (how the particle grid is drawn over the target).
+///   pixels wide at the distance of the camera target. They are traced in a scene of their own: a
+///   wire is drawn when it is in front of the surface the ray sees or less than
+///   `RenderOptions::wire_depth_tolerance` behind it, so a grid lying on (or just under) a surface
+///   shows whole while surfaces well in front hide it. An object with `surface = false` shows only
+///   its edges (how the particle grid is drawn over the target).
 ///
 /// Shading: both sides of a polygon are lit alike (the normal is flipped to face the ray). Lambert
 /// with smooth normals (area-weighted averages of the polygons' Newell normals at the vertices,
@@ -107,6 +106,11 @@ struct RenderOptions {
   /// Direction towards the key light in camera coordinates (x right, y up, z towards the viewer):
   /// by default from the upper left, in front.
   Eigen::Vector3d key_light_direction{-0.5, 0.8, 0.6};
+  /// How far behind the surface seen along a ray a wire may be and still be drawn, as a fraction
+  /// of the scene's bounding-box diagonal, >= 0. A particle grid's points lie on the smooth limit
+  /// surface, which lies slightly inside the control mesh's convex parts: drawn over the control
+  /// mesh, its edges would be hidden without this slack.
+  double wire_depth_tolerance = 0.01;
   /// Worker threads (0: all the task scheduler offers). Does not change the image.
   int threads = 0;
 };
