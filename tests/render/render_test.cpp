@@ -9,6 +9,7 @@
 
 #include "elastic/core/error.h"
 #include "elastic/image/image.h"
+#include "elastic/mesh/mesh_io.h"
 #include "elastic/render/camera.h"
 #include "elastic/shapes/procedural_shapes.h"
 #include "support.h"
@@ -151,6 +152,32 @@ TEST(Render, TexturedPlaneShowsTheLeftHalfLeftAndTheRightHalfRight) {
   }
   EXPECT_GT(reds, 200);
   EXPECT_EQ(reds, blues);
+}
+
+TEST(Render, TextureFromAnObjMaterialFileLandsOnItsHalf) {
+  // The file route: OBJ + MTL + PNG written, read back, the texture loaded by render() itself.
+  const auto dir = test::scratch_dir("obj_texture");
+  Image texture(8, 4);
+  for (int y = 0; y < 4; ++y) {
+    for (int x = 0; x < 8; ++x) {
+      texture.at(x, y) = x < 4 ? Eigen::Vector4f(1, 0, 0, 1) : Eigen::Vector4f(0, 0, 1, 1);
+    }
+  }
+  write_png(dir / "halves.png", texture);
+  PolygonMesh plane = grid_plane(1);
+  plane.materials.push_back(Material{"halves", {0.8, 0.8, 0.8}, dir / "halves.png"});
+  plane.face_materials = {0};
+  write_mesh(dir / "plane.obj", plane);
+  Scene scene;
+  scene.objects.push_back({read_mesh(dir / "plane.obj").mesh, {}});
+  const Camera camera = head_on(32);
+  const Image image = render(scene, camera);
+  EXPECT_TRUE(is_red(image.at(static_cast<int>(project(camera, {-0.5, 0, 0}).pixel.x()), 16)));
+  EXPECT_TRUE(is_blue(image.at(static_cast<int>(project(camera, {0.5, 0, 0}).pixel.x()), 16)));
+  // Without a texture the material's Kd shows (ColorSource::Materials), shaded.
+  scene.objects[0].look.colors = ColorSource::Materials;
+  const Image plain = render(scene, camera);
+  EXPECT_NEAR(plain.at(16, 16).x(), 0.8f * head_on_light(), 1e-5f);
 }
 
 TEST(Render, TextureRowsAreUpsideUp) {
