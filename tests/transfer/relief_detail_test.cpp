@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <memory>
@@ -167,6 +168,69 @@ TEST(ReliefDetail, BumpOnACylinderKeepsItsHeightAlongTheNormal) {
   const size_t apex = 10 * 21 + 10;
   EXPECT_LT((pasted.mesh.positions[apex] - centre.position).norm(), amplitude * (1.0 + 1e-6));
   EXPECT_NEAR((pasted.mesh.positions[apex] - centre.position).norm(), amplitude, 1e-6);
+}
+
+// The piecewise-linear interpolation of bump_mesh's heights at (x, y): quads split from their first
+// corner into (a, a+1, a+n+1) and (a, a+n+1, a+n), as the footprint fans them.
+double bump_interpolated(const PolygonMesh& bump, const Eigen::Vector2d& center, double half, int n,
+                         double x, double y) {
+  const double step = 2.0 * half / (n - 1.0);
+  const double fx = (x - (center.x() - half)) / step, fy = (y - (center.y() - half)) / step;
+  const int i = std::clamp(static_cast<int>(std::floor(fx)), 0, n - 2);
+  const int j = std::clamp(static_cast<int>(std::floor(fy)), 0, n - 2);
+  const double s = fx - i, t = fy - j;
+  const int a = j * n + i;
+  const auto z = [&](int v) { return bump.positions[static_cast<size_t>(v)].z(); };
+  if (s >= t) return z(a) + s * (z(a + 1) - z(a)) + t * (z(a + n + 1) - z(a + 1));
+  return z(a) + t * (z(a + n) - z(a)) + s * (z(a + n + 1) - z(a + n));
+}
+
+// Applied to target samples (the target region's vertices, each with its inverse-mapped source):
+// on the identity map every sample under the bump rises by the bump's interpolated height at its
+// source point; samples off the bump, and pinned ones, stay.
+TEST(ReliefDetail, DetailOnTargetSamplesIsTheInterpolatedBump) {
+  const auto m = plane_onto_moved_plane(Eigen::Isometry3d::Identity());
+  const Eigen::Vector2d center(0.1, 0.05);
+  const PolygonMesh bump = bump_mesh(center, 0.3, 13, 0.05, 0.12);
+  const DetailField field = extract_detail(*m->source, bump);
+  const Region& to = m->to;
+  const size_t n = static_cast<size_t>(to.num_vertices());
+  std::vector<Mapping::Location> sources(n);
+  std::vector<char> pinned(n, 0);
+  for (size_t i = 0; i < n; ++i) sources[i] = m->result.mapping.inverse(to.points[i]);
+  pinned[0] = 1;
+  const DetailSamplesResult r =
+      paste_detail_on_samples(field, *m->differential, to.points, to.positions, sources, pinned);
+  int under = 0, off = 0;
+  for (size_t i = 0; i < n; ++i) {
+    const Eigen::Vector3d moved = r.positions[i] - to.positions[i];
+    if (!sources[i].inside || pinned[i]) {
+      EXPECT_EQ(moved, Eigen::Vector3d::Zero());
+      continue;
+    }
+    const Eigen::Vector3d& p = sources[i].position;
+    const bool inside_bump =
+        std::abs(p.x() - center.x()) < 0.3 - 1e-9 && std::abs(p.y() - center.y()) < 0.3 - 1e-9;
+    const bool outside_bump =
+        std::abs(p.x() - center.x()) > 0.3 + 0.03 || std::abs(p.y() - center.y()) > 0.3 + 0.03;
+    if (inside_bump) {
+      ASSERT_TRUE(r.covered[i]) << "sample " << i;
+      // T is the identity to ~1e-6 and multiplies offsets of at most 0.05; the magnet's base
+      // points are exact to ~1e-12.
+      const double h = bump_interpolated(bump, center, 0.3, 13, p.x(), p.y());
+      EXPECT_LT((moved - Eigen::Vector3d(0.0, 0.0, h)).norm(), 1e-7) << "sample " << i;
+      ++under;
+    } else if (outside_bump) {
+      // More than half a footprint edge (0.025) away from the bump's square: off the detail.
+      EXPECT_FALSE(r.covered[i]);
+      EXPECT_EQ(moved, Eigen::Vector3d::Zero());
+      ++off;
+    }
+  }
+  EXPECT_GT(under, 50);
+  EXPECT_GT(off, 50);
+  EXPECT_EQ(r.covered_count, static_cast<int>(std::count(r.covered.begin(), r.covered.end(), 1)));
+  EXPECT_NEAR(r.max_displacement, 0.05, 0.005);  // the apex, up to the footprint's linear blend
 }
 
 // Detail vertices whose base point is outside the mapped region are dropped with their faces.

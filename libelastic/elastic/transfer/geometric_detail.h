@@ -32,6 +32,7 @@
 /// vertices whose base point maps outside the target region are dropped with their faces.
 
 #include <Eigen/Core>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -92,5 +93,50 @@ struct PasteDetailResult {
 PasteDetailResult paste_detail(const DetailField& field, const Mapping& mapping,
                                const MapDifferential& differential,
                                const PasteDetailOptions& options = {});
+
+/// The detail applied to target samples (e.g. the refined target region of
+/// transfer/target_samples.h) instead of carried as its own mesh: sample i at target point
+/// `target_points[i]` (position `target_positions[i]`) whose source is `sources[i]` (the inverse
+/// map's Location, on the base) moves to
+///
+///     y_i = x_i + scale * T(p_i -> q_i) o(p_i),
+///
+/// where o(p) is the detail's offset interpolated at the source point p: the detail faces are laid
+/// on the base through their vertices' base points (the "footprint", fan-triangulated), p's
+/// position is located in it (nearest footprint triangle, by a uniform grid over the triangles),
+/// and the corners' world offsets x - b are blended with p's barycentric coordinates there. For a
+/// detail that is a height field over the base this is linear interpolation of its heights.
+/// Samples whose source lies off the footprint (farther than `footprint_tolerance` times the mean
+/// footprint edge) keep their position; samples flagged in `pinned` (e.g.
+/// TargetSamples::on_boundary, to stay watertight with the surface around) too.
+struct DetailSamplesResult {
+  std::vector<Eigen::Vector3d> positions;  ///< #S displaced positions
+  std::vector<char> covered;               ///< #S 1 where the detail was applied
+  int covered_count = 0;                   ///< samples the detail moved
+  int without_source = 0;                  ///< samples whose Location is not inside
+  double max_displacement = 0.0;           ///< largest |y - x|
+};
+
+struct DetailSamplesOptions {
+  /// Tangential offsets: Stretch or Rotation, as in PasteDetailOptions.
+  VectorTransport tangential = VectorTransport::Stretch;
+  /// Multiplies every offset.
+  double scale = 1.0;
+  /// A source point farther from the footprint than this times the mean footprint edge length is
+  /// off the detail.
+  double footprint_tolerance = 0.5;
+  /// Name used in error messages.
+  std::string name = "detail";
+};
+
+/// \throws InvalidInputError (naming options.name) when the sizes disagree (`pinned` may be
+///         empty) or the scale is not finite.
+DetailSamplesResult paste_detail_on_samples(const DetailField& field,
+                                            const MapDifferential& differential,
+                                            std::span<const SurfacePoint> target_points,
+                                            std::span<const Eigen::Vector3d> target_positions,
+                                            std::span<const Mapping::Location> sources,
+                                            std::span<const char> pinned = {},
+                                            const DetailSamplesOptions& options = {});
 
 }  // namespace elastic
