@@ -181,7 +181,7 @@ struct VectorTransferResult {
 /// in `source_frames[i]` when that is not empty; the results are world vectors, or components in
 /// `target_frames[i]` when that is not empty.
 /// \throws InvalidInputError (naming options.name) when the sizes disagree or a vector is not
-///         finite.
+///         finite; NumericalError when a sample's grid triangle is degenerate.
 VectorTransferResult transfer_vectors(const MapDifferential& differential,
                                       std::span<const SurfacePoint> target_points,
                                       std::span<const Mapping::Location> sources,
