@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cmath>
 #include <complex>
+#include <exception>
 #include <limits>
 #include <map>
 #include <string>
@@ -270,13 +271,30 @@ BaselineResult map_baseline(const ParticleGrid& grid, const SurfaceProjector& so
   const CgalFlatteningOptions flattening{.arap_iterations = options.arap_iterations,
                                          .arap_lambda = options.arap_lambda,
                                          .arap_tolerance = options.arap_tolerance,
+                                         .arap_max_vertices = options.arap_max_vertices,
                                          .name = "source region"};
   CgalFlatteningOptions target_flattening = flattening;
   target_flattening.name = "target region";
   CgalFlattening from, to;
+  // Each task keeps its own exception, so that when both fail the error is always the source's.
+  std::exception_ptr source_error, target_error;
   tbb::parallel_invoke(
-      [&] { from = flatten_region_cgal(source_region, options.kind, flattening); },
-      [&] { to = flatten_region_cgal(target_region, options.kind, target_flattening); });
+      [&] {
+        try {
+          from = flatten_region_cgal(source_region, options.kind, flattening);
+        } catch (...) {
+          source_error = std::current_exception();
+        }
+      },
+      [&] {
+        try {
+          to = flatten_region_cgal(target_region, options.kind, target_flattening);
+        } catch (...) {
+          target_error = std::current_exception();
+        }
+      });
+  if (source_error) std::rethrow_exception(source_error);
+  if (target_error) std::rethrow_exception(target_error);
   result.source_flipped_triangles = from.flipped_triangles;
   result.target_flipped_triangles = to.flipped_triangles;
 

@@ -51,6 +51,12 @@ struct BaselineOptions {
   /// ARAP stops when one iteration changes the energy by less than this fraction (CGAL's
   /// tolerance; <= 0 always runs arap_iterations).
   double arap_tolerance = 1e-6;
+  /// Largest region (vertices) given to ARAP. When CGAL 5.5's ARAP leaves flipped triangles it runs
+  /// MVC_post_processor_3, whose matrix assembly inserts entries one by one into a compressed
+  /// sparse matrix (quadratic): a 182,000-vertex region ran for over 20 minutes there. Larger
+  /// regions are refused (InvalidInputError) instead of hanging; coarsen the projector's
+  /// tessellation or raise this.
+  int arap_max_vertices = 50000;
   /// Common correspondence parameters s = i / n sampled on both boundaries to fit the alignment.
   int alignment_samples = 2048;
   /// Barycentric tolerance of point location in the flattenings (relative to a triangle: 1e-9 is

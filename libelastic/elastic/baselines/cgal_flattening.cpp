@@ -223,6 +223,14 @@ CgalFlattening flatten_region_cgal(const Region& region, BaselineKind kind,
       if (options.arap_iterations < 1) {
         throw InvalidInputError(name, "ARAP needs at least one iteration");
       }
+      if (used_vertices > options.arap_max_vertices) {
+        throw InvalidInputError(
+            name, "region has " + std::to_string(used_vertices) +
+                      " vertices, more than ARAP's limit of " +
+                      std::to_string(options.arap_max_vertices) +
+                      " (CGAL's ARAP post-processor is quadratic in the region size; coarsen "
+                      "the tessellation or raise arap_max_vertices)");
+      }
       using Parameterizer = SMP::ARAP_parameterizer_3<Mesh, SMP::Two_vertices_parameterizer_3<Mesh>,
                                                       CachedSparseLuTraits>;
       Parameterizer parameterizer(

@@ -31,6 +31,8 @@ struct CgalFlatteningOptions {
   /// ARAP stops when the relative energy change of one iteration falls below this (CGAL's
   /// tolerance; <= 0 runs all iterations).
   double arap_tolerance = 1e-6;
+  /// Regions with more vertices are refused by ARAP (see BaselineOptions::arap_max_vertices).
+  int arap_max_vertices = 50000;
   std::string name = "region";  ///< names the region in error messages
 };
 
@@ -42,7 +44,8 @@ struct CgalFlattening {
 
 /// Flattens `region` with the CGAL parameterizer of `kind`.
 /// \throws InvalidInputError naming options.name when the region is empty, is not a manifold
-///         topological disk with one boundary loop, or has zero area; NumericalError when CGAL
+///         topological disk with one boundary loop, or (ARAP) has more than arap_max_vertices
+///         vertices; NumericalError when CGAL
 ///         reports a failure (its error message is included).
 CgalFlattening flatten_region_cgal(const Region& region, BaselineKind kind,
                                    const CgalFlatteningOptions& options = {});
