@@ -17,6 +17,28 @@ double seconds_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
+/// The subdivision step after the map (end of §4.3): one entry per level.
+nlohmann::json subdivision_report(const MapResult& r) {
+  nlohmann::json levels = nlohmann::json::array();
+  for (const RefinementLevel& level : r.subdivision_levels) {
+    levels.push_back({{"particles_before", level.particles_before},
+                      {"particles_after", level.particles_after},
+                      {"iterations", level.iterations},
+                      {"converged", level.converged},
+                      {"reason", std::string(to_string(level.reason))},
+                      {"initial_folds", level.initial_folded_faces},
+                      {"folds", level.folded_faces},
+                      {"energy_before", level.initial_energy},
+                      {"energy", level.energy},
+                      {"seconds", level.seconds_subdivide + level.seconds_relax}});
+  }
+  return {{"levels", r.subdivisions},
+          {"sampled_particles", r.sampled_particles},
+          {"iterations", r.subdivision_iterations},
+          {"seconds", r.seconds_subdivision},
+          {"per_level", levels}};
+}
+
 }  // namespace
 
 Eigen::Vector3d parse_point(const std::string& text, const std::string& flag) {
@@ -113,9 +135,7 @@ std::unique_ptr<MapSession> run_map_job(const MapJob& job, const ProgressCallbac
   options.relaxation.solver = job.solver == "explicit" ? SolverKind::Faithful : SolverKind::Fast;
   options.relaxation.threads = job.threads;
   options.relaxation.max_iterations = job.max_iterations;
-  if (job.subdivide > 0) {
-    throw UsageError("--subdivide is not available in this build yet");
-  }
+  options.subdivisions = job.subdivide;
   options.progress = progress;
   options.relaxation.progress = progress;
   s.result = map_regions(*s.source.projector, s.source_region, *s.target.projector, s.target_region,
@@ -158,6 +178,7 @@ nlohmann::json map_report(const MapJob& job, const MapSession& session,
           {"initial_folds", x.initial_folded_faces},
           {"boundary_residual", x.boundary_residual},
           {"rest_scale", {{"mode", job.rest_scale}, {"factor", r.rest_scale}}},
+          {"subdivision", subdivision_report(r)},
           {"sampling",
            {{"spacing_min", s.spacing_min},
             {"spacing_median", s.spacing_median},
