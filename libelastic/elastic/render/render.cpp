@@ -287,6 +287,8 @@ class Tracer {
       }
       if (look.wireframe) add_curves(static_cast<int>(k));
     }
+    // Robust (watertight) triangle tests: no background pixels leaking through shared edges.
+    rtcSetSceneFlags(surfaces_.handle, RTC_SCENE_FLAG_ROBUST);
     rtcCommitScene(surfaces_.handle);
     rtcCommitScene(wires_.handle);
     check_device(device_.handle, "build the scene");
