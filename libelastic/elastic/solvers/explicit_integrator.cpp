@@ -71,8 +71,7 @@ RelaxationResult relax_explicit(const RelaxationProblem& problem,
       eo.time_step > 0.0 ? eo.time_step : eo.stability_factor * 2.0 * std::sqrt(mass / lambda_max);
   double damping = eo.damping;
   if (damping == 0.0) {
-    Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> factor;
-    solver_detail::factorize(laplacian, factor);
+    const solver_detail::LaplacianFactor factor(laplacian, interior_coordinates(setup));
     // Inverse iteration from the all-ones vector (the slowest Dirichlet mode has one sign).
     Eigen::VectorXd v = Eigen::VectorXd::Ones(laplacian.rows()).normalized();
     for (int it = 0; it < 30; ++it) v = factor.solve(v).normalized();

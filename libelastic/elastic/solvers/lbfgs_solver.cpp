@@ -1,7 +1,9 @@
 #include "elastic/solvers/lbfgs_solver.h"
 
+#include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include <Eigen/Geometry>
 #include <Eigen/SparseCholesky>
 #include <algorithm>
 #include <cmath>
@@ -21,6 +23,9 @@ using solver_detail::RelaxationSetup;
 constexpr int kFoldHalvings = 4;
 // Rounds of blocking fold-making particles per line search before the step is halved instead.
 constexpr int kMaxBlockRounds = 8;
+// Releases of the held particles (all at once) before the solver accepts that the minimum is
+// fold-constrained.
+constexpr int kMaxReleases = 1;
 // Consecutive steps without an energy change beyond round-off before the solver gives up.
 constexpr int kMaxStalled = 20;
 
@@ -59,6 +64,65 @@ struct InteriorLayout {
   }
 };
 
+// The parameter-space tangent basis of a surface point: d(position)/du and d/dv.
+struct Tangent {
+  Eigen::Vector3d du = Eigen::Vector3d::Zero();
+  Eigen::Vector3d dv = Eigen::Vector3d::Zero();
+  Eigen::Vector3d duu = Eigen::Vector3d::Zero();
+  Eigen::Vector3d duv = Eigen::Vector3d::Zero();
+  Eigen::Vector3d dvv = Eigen::Vector3d::Zero();
+};
+
+Tangent tangent_frame(const SurfaceDerivatives& d) {
+  return {d.du, d.dv, d.duu, d.duv, d.dvv};
+}
+Tangent tangent_frame(const LimitSurface& surface, const SurfacePoint& point) {
+  return tangent_frame(surface.derivatives(point));
+}
+
+// The retraction of the line search: a tangent step t at surface point `from` becomes the
+// parameter step delta = (J^T J)^-1 J^T t, J = [du dv] (the least-squares pull-back of t), walked
+// across ptex faces (LimitSurface::walk), and the particle goes to the limit position there. To
+// first order in |t| this is x + t, as is the closest point of x + t (the magnet): both are
+// retractions, and a minimum of the energy on the surface does not depend on which one the line
+// search uses. This one costs one patch evaluation per particle, against the Newton iterations of
+// the closest-point query. Returns false, leaving the magnet to the caller, when the
+// parameterisation is degenerate at either end or the walk stops on the surface boundary.
+bool parametric_step(const LimitSurface& surface, const SurfacePoint& from, const Tangent& frame,
+                     const Eigen::Vector3d& t, ClosestPoint& out, Tangent& out_frame) {
+  const double a = frame.du.squaredNorm(), b = frame.du.dot(frame.dv), c = frame.dv.squaredNorm();
+  const double det = a * c - b * b;
+  // det = |du x dv|^2: relative to a c it is sin^2 of the angle between du and dv.
+  if (!(det > 1e-12 * a * c)) return false;
+  // Least-squares pull-back of a 3D vector into the parameter plane: (J^T J)^-1 J^T w.
+  const auto pull_back = [&](const Eigen::Vector3d& w) {
+    const double wu = frame.du.dot(w), wv = frame.dv.dot(w);
+    return Eigen::Vector2d((c * wu - b * wv) / det, (a * wv - b * wu) / det);
+  };
+  // Second order: d(delta) = x + J delta + 1/2 delta^T H delta + O(delta^3). Removing the tangent
+  // part of the quadratic term makes the tangent displacement t + O(|t|^3), like the closest point
+  // of x + t, so the L-BFGS pairs see the same curvature as with the magnet.
+  const Eigen::Vector2d first = pull_back(t);
+  const Eigen::Vector3d bend =
+      0.5 * (first.x() * first.x() * frame.duu + 2.0 * first.x() * first.y() * frame.duv +
+             first.y() * first.y() * frame.dvv);
+  const Eigen::Vector2d delta = first - pull_back(bend);
+  const SurfacePoint to = surface.walk(from, delta);
+  if (surface.on_boundary(to)) return false;
+  const SurfaceDerivatives d = surface.derivatives(to);
+  const Eigen::Vector3d normal = d.du.cross(d.dv);
+  const double length = normal.norm();
+  if (!(length > 1e-6 * d.du.norm() * d.dv.norm())) return false;
+  out.point = to;
+  out.position = d.position;
+  out.normal = normal / length;
+  out.distance = 0.0;
+  out.on_boundary = false;
+  out.converged = true;
+  out_frame = tangent_frame(d);
+  return true;
+}
+
 struct Pair {
   Eigen::VectorXd s, y;
   double rho = 0.0;  // 1 / (s . y)
@@ -92,22 +156,34 @@ RelaxationResult relax_lbfgs(const RelaxationProblem& problem, const RelaxationO
     return result;
   }
 
-  // H0 = L^-1: the interior spring Laplacian, factorised once (AMD ordering inside SimplicialLDLT).
-  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> laplacian;
-  solver_detail::factorize(solver_detail::interior_laplacian(setup, options), laplacian);
-  // The x, y and z solves are independent (const solves of one factor): run them in parallel when
-  // the system is large enough for it to pay. Each column's arithmetic is the same either way.
-  const auto apply_h0 = [&](const Eigen::VectorXd& q) {
-    Eigen::VectorXd r(3 * n);
-    const auto solve_column = [&](int c) {
-      r.segment(c * n, n) = laplacian.solve(q.segment(c * n, n));
-    };
-    if (n >= 20000) {
-      tbb::parallel_for(0, 3, solve_column);
-    } else {
-      for (int c = 0; c < 3; ++c) solve_column(c);
-    }
-    return r;
+  // H0 = L^-1: the interior spring Laplacian, ordered by nested dissection and factorised once.
+  const solver_detail::LaplacianFactor laplacian(solver_detail::interior_laplacian(setup, options),
+                                                 solver_detail::interior_coordinates(setup));
+
+  // Held particles (see the file comment of lbfgs_solver.h): interior particles that the line
+  // search stopped from folding a face. They stay where they are, like boundary particles, until a
+  // release; the solver works in the subspace of the others: the held rows of the tangential
+  // gradient, of H0 = L^-1 and of the direction are zero.
+  std::vector<char> held(static_cast<std::size_t>(n), 0);
+  Eigen::Index held_count = 0;
+  int releases = 0;
+  const auto mask = [&](Eigen::VectorXd& v) {
+    if (held_count == 0) return;
+    for (Eigen::Index k = 0; k < n; ++k)
+      if (held[static_cast<std::size_t>(k)])
+        for (int d = 0; d < 3; ++d) v[d * n + k] = 0.0;
+  };
+  const auto apply_h0 = [&](Eigen::VectorXd v) {
+    mask(v);
+    v = laplacian.solve3(v);
+    mask(v);
+    return v;
+  };
+  // The tangential gradient of the particles that are not held.
+  const auto free_part = [&](const Eigen::VectorXd& v) {
+    Eigen::VectorXd w = v;
+    mask(w);
+    return w;
   };
 
   std::vector<char> folded;
@@ -120,12 +196,14 @@ RelaxationResult relax_lbfgs(const RelaxationProblem& problem, const RelaxationO
   const long long solve_start = solver_detail::now_ticks();
 
   std::deque<Pair> memory;
-  std::vector<char> blocked(static_cast<std::size_t>(n), 0);  // free particles held back this step
-  bool last_blocked = false;
-  Eigen::Index blocked_count = 0;
   int stalled = 0;  // consecutive steps that changed the energy by less than its round-off
-  std::vector<Eigen::Vector3d> trial_query(static_cast<std::size_t>(n));
-  std::vector<SurfacePoint> hints(static_cast<std::size_t>(n));
+  // Tangent frames (du, dv) of the interior particles at their current and trial surface points.
+  std::vector<Tangent> frames(static_cast<std::size_t>(n)), trial_frames(frames.size());
+  tbb::parallel_for(Eigen::Index{0}, n, [&](Eigen::Index k) {
+    frames[static_cast<std::size_t>(k)] = tangent_frame(
+        setup.target.surface(),
+        setup.points[static_cast<std::size_t>(setup.interior[static_cast<std::size_t>(k)])]);
+  });
   std::vector<ClosestPoint> projected(static_cast<std::size_t>(n));
   Eigen::Matrix3Xd trial_positions, trial_normals, trial_gradient;
   std::vector<char> trial_folded;
@@ -148,18 +226,23 @@ RelaxationResult relax_lbfgs(const RelaxationProblem& problem, const RelaxationO
       result.reason = StopReason::AbsoluteGradient;
       break;
     }
-    if (last_blocked && blocked_count <= std::max<Eigen::Index>(1, n / 20)) {
-      // A few particles were held back from folding a face in the last step. If every other
-      // particle is at equilibrium, the energy minimum lies beyond the no-fold constraint: stop and
-      // say so. (With many blocked particles the remaining gradient says little: go on.)
-      double free_sum = 0.0;
-      for (Eigen::Index k = 0; k < n; ++k)
-        if (!blocked[static_cast<std::size_t>(k)]) free_sum += layout.at(q, k).squaredNorm();
-      const double free_norm = std::sqrt(free_sum);
+    Eigen::VectorXd q_free = free_part(q);
+    if (held_count > 0) {
+      const double free_norm = q_free.norm();
       if (free_norm <= options.relative_gradient_tolerance * initial_norm ||
           free_norm <= setup.absolute_bound) {
-        result.reason = StopReason::FoldConstrained;
-        break;
+        // Every particle that is not held is at equilibrium. Release the held ones once: if the
+        // energy lets them move away from the fold, the solver goes on; if they are held again and
+        // the rest settles again, the minimum lies beyond the no-fold constraint.
+        if (releases >= kMaxReleases) {
+          result.reason = StopReason::FoldConstrained;
+          break;
+        }
+        ++releases;
+        std::fill(held.begin(), held.end(), 0);
+        held_count = 0;
+        memory.clear();
+        q_free = q;
       }
     }
     if (stalled >= kMaxStalled) {
@@ -177,7 +260,7 @@ RelaxationResult relax_lbfgs(const RelaxationProblem& problem, const RelaxationO
     }
 
     // Two-loop recursion with H0 = L^-1 (newest pair first, then back).
-    Eigen::VectorXd direction = q;
+    Eigen::VectorXd direction = q_free;
     std::vector<double> alphas(memory.size());
     for (std::size_t m = memory.size(); m-- > 0;) {
       alphas[m] = memory[m].rho * memory[m].s.dot(direction);
@@ -190,36 +273,55 @@ RelaxationResult relax_lbfgs(const RelaxationProblem& problem, const RelaxationO
     }
     direction = -direction;
     layout.project(direction, setup.normals);
-    double slope = q.dot(direction);
+    double slope = q_free.dot(direction);
     if (!(slope < 0.0)) {
       memory.clear();
-      direction = -apply_h0(q);
+      direction = -apply_h0(q_free);
       layout.project(direction, setup.normals);
-      slope = q.dot(direction);
+      slope = q_free.dot(direction);
       if (!(slope < 0.0)) {  // L is SPD, so only round-off gets here: fall back to steepest descent
-        direction = -q;
-        slope = -q_norm * q_norm;
+        direction = -q_free;
+        slope = -q_free.squaredNorm();
       }
     }
 
-    // Backtracking line search along the retraction x + alpha p -> closest point.
-    for (Eigen::Index k = 0; k < n; ++k)
-      hints[static_cast<std::size_t>(k)] =
-          setup.points[static_cast<std::size_t>(setup.interior[k])];
+    // Backtracking line search along the retraction (see retract above).
+    const auto retract = [&](double alpha) {
+      tbb::parallel_for(
+          tbb::blocked_range<Eigen::Index>(0, n, 1024),
+          [&](const tbb::blocked_range<Eigen::Index>& range) {
+            for (Eigen::Index k = range.begin(); k != range.end(); ++k) {
+              const auto kk = static_cast<std::size_t>(k);
+              const auto p = static_cast<std::size_t>(setup.interior[kk]);
+              const Eigen::Vector3d step = alpha * layout.at(direction, k);
+              ClosestPoint& out = projected[kk];
+              Tangent& frame = trial_frames[kk];
+              if (step.isZero(0.0)) {  // blocked (or converged) particle: exactly where it is
+                out.point = setup.points[p];
+                out.position = setup.positions.col(static_cast<Eigen::Index>(p));
+                out.normal = setup.normals.col(static_cast<Eigen::Index>(p));
+                frame = frames[kk];
+                continue;
+              }
+              if (!parametric_step(setup.target.surface(), setup.points[p], frames[kk], step, out,
+                                   frame)) {
+                // Magnet fallback: the closest point of x + alpha p, warm started.
+                out = setup.target.closest(
+                    Eigen::Vector3d(setup.positions.col(static_cast<Eigen::Index>(p)) + step),
+                    setup.points[p]);
+                frame = tangent_frame(setup.target.surface(), out.point);
+              }
+            }
+          });
+    };
     bool accepted = false;
     double alpha = 1.0;
     SpringEnergies trial_energies;
     Eigen::VectorXd trial_q;
-    std::fill(blocked.begin(), blocked.end(), 0);
     int backtracks = 0, block_rounds = 0, fold_halvings = 0;
-    blocked_count = 0;
     while (backtracks < lb.max_backtracks && slope < 0.0) {
       trial_q.resize(0);
-      for (Eigen::Index k = 0; k < n; ++k)
-        trial_query[static_cast<std::size_t>(k)] =
-            setup.positions.col(setup.interior[static_cast<std::size_t>(k)]) +
-            alpha * layout.at(direction, k);
-      setup.target.closest(trial_query, projected, hints);
+      retract(alpha);
       trial_positions = setup.positions;
       trial_normals = setup.normals;
       for (Eigen::Index k = 0; k < n; ++k) {
@@ -235,20 +337,29 @@ RelaxationResult relax_lbfgs(const RelaxationProblem& problem, const RelaxationO
         if (!trial_folded[c] || folded[c]) continue;
         new_fold = true;
         if (!block_now) break;
-        // Block the free particles of the newly folded corner: they keep their position this step.
+        // Hold the free particles of the newly folded corner: they keep their position from now
+        // on (until a release).
         const SpringSystem::Corner& corner = setup.springs.corners()[c];
         for (const int p : {corner.i, corner.next, corner.prev}) {
           const int k = setup.interior_index[static_cast<std::size_t>(p)];
-          if (k < 0 || blocked[static_cast<std::size_t>(k)]) continue;
-          blocked[static_cast<std::size_t>(k)] = 1;
-          ++blocked_count;
+          if (k < 0 || held[static_cast<std::size_t>(k)]) continue;
+          held[static_cast<std::size_t>(k)] = 1;
+          ++held_count;
           for (int d = 0; d < 3; ++d) direction[d * n + k] = 0.0;
         }
       }
       if (new_fold) {
         if (block_now) {
-          ++block_rounds;  // retry the same step length without the blocked particles
-          slope = q.dot(direction);
+          // Retry the same step length without the held particles. Zeroing rows of a descent
+          // direction need not leave a descent direction, so it is recomputed in the new subspace
+          // (memory cleared: its pairs mix held and free rows): -P L^-1 q_free, which is one since
+          // the masked L^-1 is positive semi-definite and positive on the free rows.
+          ++block_rounds;
+          memory.clear();
+          q_free = free_part(q);
+          direction = -apply_h0(q_free);
+          layout.project(direction, setup.normals);
+          slope = q_free.dot(direction);
         } else {
           alpha *= 0.5;
           ++backtracks;
@@ -266,14 +377,13 @@ RelaxationResult relax_lbfgs(const RelaxationProblem& problem, const RelaxationO
         } else if (trial_energy <= energy + 1e-13 * energy) {
           // Within round-off of the current energy: accept on a smaller tangential gradient.
           trial_q = layout.tangential(trial_gradient, trial_normals);
-          accepted = trial_q.norm() < q_norm;
+          accepted = free_part(trial_q).norm() < q_free.norm();
         }
       }
       if (accepted) break;
       alpha *= 0.5;
       ++backtracks;
     }
-    last_blocked = block_rounds > 0;
     if (!accepted) {
       if (!memory.empty()) {  // retry from the preconditioned gradient before giving up
         memory.clear();
@@ -291,7 +401,7 @@ RelaxationResult relax_lbfgs(const RelaxationProblem& problem, const RelaxationO
       const Eigen::Vector3d step = trial_positions.col(p) - setup.positions.col(p);
       for (int c = 0; c < 3; ++c) pair.s[c * n + k] = step[c];
     }
-    pair.y = trial_q - q;
+    pair.y = free_part(trial_q) - q_free;
     const double sy = pair.s.dot(pair.y);
     if (sy > 1e-12 * pair.s.norm() * pair.y.norm() && lb.memory > 0) {
       pair.rho = 1.0 / sy;
@@ -304,6 +414,7 @@ RelaxationResult relax_lbfgs(const RelaxationProblem& problem, const RelaxationO
     for (Eigen::Index k = 0; k < n; ++k)
       setup.points[static_cast<std::size_t>(setup.interior[static_cast<std::size_t>(k)])] =
           projected[static_cast<std::size_t>(k)].point;
+    frames.swap(trial_frames);
     folded.swap(trial_folded);
     gradient.swap(trial_gradient);
     stalled =
@@ -314,6 +425,9 @@ RelaxationResult relax_lbfgs(const RelaxationProblem& problem, const RelaxationO
     emit_frame(iteration + 1);
   }
 
+  for (Eigen::Index k = 0; k < n; ++k)
+    if (held[static_cast<std::size_t>(k)])
+      result.held_particles.push_back(setup.interior[static_cast<std::size_t>(k)]);
   result.iterations = iteration;
   result.solve_seconds = solver_detail::seconds_since(solve_start);
   solver_detail::finish_result(setup, problem, initial_norm, result);

@@ -11,31 +11,38 @@
 /// 2. Direction p = -H q by the L-BFGS two-loop recursion over the last `memory` pairs (s, y)
 ///    (s: change of the positions, y: change of P g), with the initial inverse Hessian H0 = L^-1,
 ///    L the interior spring Laplacian (solver_common.h: 2C per spring plus the angular springs'
-///    Gram matrices), factorised once with a sparse LDL^T and applied to the x, y and z
-///    coordinates. The first step is therefore the Laplacian solve -L^-1 P g, a Newton step for the
-///    springs linearised at rest.
+///    Gram matrices), ordered by geometric nested dissection, factorised once with a sparse LDL^T
+///    and applied to the x, y and z coordinates. The first step is therefore the Laplacian solve
+///    -L^-1 P g, a Newton step for the springs linearised at rest.
 /// 3. p is projected on the tangent planes again. If it is not a descent direction (P g . p >= 0)
 ///    the memory is cleared and p = -P L^-1 P g is used.
-/// 4. Retraction: x_i(alpha) = closest point on the surface to x_i + alpha p_i (the magnet of §4.4,
-///    warm started from the particle's current surface point).
+/// 4. Retraction: the tangent step t_i = alpha p_i is pulled back to the parameter plane of the
+///    particle's ptex face, delta = (J^T J)^-1 J^T t with J = [du dv], corrected to second order
+///    by the surface's second derivatives, walked across ptex edges, and evaluated: one patch
+///    evaluation per particle. Like the magnet (closest point of x + t, §4.4) it moves the particle
+///    by t + O(|t|^3) along the surface; where the parameterisation is degenerate or the walk
+///    reaches the surface boundary the magnet itself is used (warm started).
 /// 5. Backtracking line search from alpha = 1. A trial that folds a face corner that was not folded
 ///    (SpringSystem::folded_corners with the new normals) is never taken. The first 4 such trials
-///    halve alpha; after that the free particles of the newly folded corners are *blocked* (their
-///    part of p is set to zero, they keep their position this step) and the same alpha is tried
-///    again, up to 8 rounds, after which alpha is halved again. A trial is also rejected (alpha
-///    halved) when the energy is not finite or the Armijo condition
-///    E(alpha) <= E + c1 alpha (P g . p) fails. Close to the minimum the energy change can drop
-///    below its round-off; a trial within 1e-13 E of the current energy is then accepted when its
-///    tangential gradient is smaller.
+///    halve alpha; after that the free particles of the newly folded corners are *held*: they keep
+///    their position from then on, like boundary particles, and the solver continues in the
+///    subspace of the others (their rows of P g, of L^-1 and of p are zero; the memory is cleared
+///    and p recomputed as -P L^-1 P g on the new subspace), retrying the same alpha, up to 8
+///    rounds, after which alpha is halved again. A trial is also rejected (alpha halved) when the
+///    energy is not finite or the Armijo condition E(alpha) <= E + c1 alpha (P g . p) fails.
+///    Close to the minimum the energy change can drop below its round-off; a trial within
+///    1e-13 E of the current energy is then accepted when its tangential gradient is smaller.
 /// 6. The pair (s, y) is kept when s . y > 1e-12 |s| |y| (curvature condition).
 ///
-/// Stopping: see relaxation.h (tangential gradient only). When a few particles (at most 5%) were
-/// blocked in the last step and the tangential gradient of all the others meets the tolerance, the
-/// energy minimum lies beyond the no-fold constraint: the solver stops with
-/// StopReason::FoldConstrained (not converged, no new folds). When no trial is accepted with an
-/// empty memory, or 20 steps in a row change the energy by less than 1e-14 E, it stops with
-/// StopReason::LineSearchFailed. Both happen when the minimum is folded, e.g. a square source
-/// region whose 90-degree corners must open to 180 degrees on a smooth target boundary.
+/// Stopping: see relaxation.h (tangential gradient only). When particles are held and the
+/// tangential gradient of all the others meets the tolerance, the held ones are released once
+/// (memory cleared); if they are held again and the rest settles again, the energy minimum lies
+/// beyond the no-fold constraint: the solver stops with StopReason::FoldConstrained (not
+/// converged, no folds, RelaxationResult::held_particles lists them). This is the case of a square
+/// source region mapped onto a round target boundary with 2,000 particles: its 90-degree corners
+/// must open to 180 degrees, and the explicit solver run to equilibrium folds faces next to them.
+/// When no trial is accepted with an empty memory, or 20 steps in a row change the energy by less
+/// than 1e-14 E, it stops with StopReason::LineSearchFailed.
 
 #include "elastic/solvers/relaxation.h"
 

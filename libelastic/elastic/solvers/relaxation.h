@@ -51,7 +51,8 @@ enum class StopReason {
   MaxIterations,     ///< not converged: the iteration budget ran out
   LineSearchFailed,  ///< not converged: no fold-free step decreases the energy (L-BFGS)
   FoldConstrained,   ///< not converged: all particles are at equilibrium except some that are held
-                     ///< back from folding a face (the energy minimum is folded; L-BFGS)
+                     ///< back from folding a face (the energy minimum is folded; L-BFGS); they
+                     ///< are listed in RelaxationResult::held_particles
   Diverged,          ///< not converged: the energy or a position became non-finite (explicit)
   Cancelled          ///< not converged: the progress callback asked to stop
 };
@@ -142,7 +143,10 @@ struct RelaxationResult {
   double initial_gradient_norm = 0.0;  ///< initial |P g|
   /// gradient_norm / initial_gradient_norm (0 when the latter is 0)
   double relative_gradient = 0.0;
-  int folded_faces = 0;            ///< faces with a folded corner at the end
+  int folded_faces = 0;  ///< faces with a folded corner at the end
+  /// L-BFGS: interior particles held where they are at the end because moving them on would fold
+  /// a face (non-empty with StopReason::FoldConstrained; they sit next to a nearly flat corner).
+  std::vector<int> held_particles;
   int initial_folded_faces = 0;    ///< the same at the start
   double boundary_residual = 0.0;  ///< max distance of a boundary particle from its target position
   double rest_scale = 1.0;         ///< sigma used

@@ -7,7 +7,9 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <string>
+#include <utility>
 
 #include "elastic/core/error.h"
 
@@ -156,16 +158,160 @@ Eigen::SparseMatrix<double> interior_laplacian(const RelaxationSetup& setup,
   return laplacian;
 }
 
-void factorize(const Eigen::SparseMatrix<double>& laplacian,
-               Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>>& factor) {
-  factor.compute(laplacian);
-  bool positive = factor.info() == Eigen::Success;
-  const Eigen::VectorXd& pivots = factor.vectorD();
+Eigen::Matrix3Xd interior_coordinates(const RelaxationSetup& setup) {
+  Eigen::Matrix3Xd x(3, setup.num_free());
+  for (int k = 0; k < setup.num_free(); ++k)
+    x.col(k) = setup.positions.col(setup.interior[static_cast<std::size_t>(k)]);
+  return x;
+}
+
+namespace {
+
+// Recursive geometric bisection (see nested_dissection_order). `nodes` is the subset to order;
+// `side` and `stamp` are scratch arrays over all n particles; the ordered subset is appended to
+// `order`.
+struct Dissection {
+  const std::vector<int>& start;  // symmetric adjacency, compressed rows
+  const std::vector<int>& adjacent;
+  const Eigen::Matrix3Xd& coordinates;
+  std::vector<int>& side;   // 0: lower half, 1: upper half, valid where stamp == current
+  std::vector<int>& stamp;  // which call last labelled the particle
+  std::vector<int>& order;
+  int calls = 0;
+
+  static constexpr std::size_t kLeaf = 64;
+
+  void run(std::vector<int> nodes) {
+    if (nodes.size() <= kLeaf) {
+      std::sort(nodes.begin(), nodes.end());
+      order.insert(order.end(), nodes.begin(), nodes.end());
+      return;
+    }
+    Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
+    Eigen::Vector3d hi = -lo;
+    for (const int v : nodes) {
+      lo = lo.cwiseMin(coordinates.col(v));
+      hi = hi.cwiseMax(coordinates.col(v));
+    }
+    Eigen::Index axis = 0;
+    (hi - lo).maxCoeff(&axis);
+    // Median split along the axis; ties by index so that the result never depends on the sort.
+    const auto half = nodes.begin() + static_cast<std::ptrdiff_t>(nodes.size() / 2);
+    std::nth_element(nodes.begin(), half, nodes.end(), [&](int a, int b) {
+      const double ca = coordinates(axis, a), cb = coordinates(axis, b);
+      return ca < cb || (ca == cb && a < b);
+    });
+    const int call = ++calls;
+    for (auto it = nodes.begin(); it != nodes.end(); ++it) {
+      stamp[static_cast<std::size_t>(*it)] = call;
+      side[static_cast<std::size_t>(*it)] = it < half ? 0 : 1;
+    }
+    // Separator: lower-half particles coupled to the upper half. Removing them disconnects the
+    // halves, so their elimination creates no fill between the halves.
+    std::vector<int> lower, upper, separator;
+    for (auto it = nodes.begin(); it != nodes.end(); ++it) {
+      const int v = *it;
+      if (it >= half) {
+        upper.push_back(v);
+        continue;
+      }
+      bool on_cut = false;
+      for (int k = start[static_cast<std::size_t>(v)];
+           !on_cut && k < start[static_cast<std::size_t>(v) + 1]; ++k) {
+        const auto w = static_cast<std::size_t>(adjacent[static_cast<std::size_t>(k)]);
+        on_cut = stamp[w] == call && side[w] == 1;
+      }
+      (on_cut ? separator : lower).push_back(v);
+    }
+    nodes.clear();
+    nodes.shrink_to_fit();
+    std::sort(separator.begin(), separator.end());
+    run(std::move(lower));
+    run(std::move(upper));
+    order.insert(order.end(), separator.begin(), separator.end());
+  }
+};
+
+}  // namespace
+
+std::vector<int> nested_dissection_order(const Eigen::SparseMatrix<double>& laplacian,
+                                         const Eigen::Matrix3Xd& coordinates) {
+  const auto n = static_cast<std::size_t>(laplacian.rows());
+  // Symmetric adjacency from the stored lower triangle.
+  std::vector<int> start(n + 1, 0);
+  for (Eigen::Index col = 0; col < laplacian.outerSize(); ++col)
+    for (Eigen::SparseMatrix<double>::InnerIterator it(laplacian, col); it; ++it)
+      if (it.row() != col) {
+        ++start[static_cast<std::size_t>(it.row()) + 1];
+        ++start[static_cast<std::size_t>(col) + 1];
+      }
+  for (std::size_t v = 0; v < n; ++v) start[v + 1] += start[v];
+  std::vector<int> adjacent(static_cast<std::size_t>(start[n]));
+  std::vector<int> fill(start.begin(), start.end() - 1);
+  for (Eigen::Index col = 0; col < laplacian.outerSize(); ++col)
+    for (Eigen::SparseMatrix<double>::InnerIterator it(laplacian, col); it; ++it)
+      if (it.row() != col) {
+        const auto r = static_cast<std::size_t>(it.row()), c = static_cast<std::size_t>(col);
+        adjacent[static_cast<std::size_t>(fill[r]++)] = static_cast<int>(c);
+        adjacent[static_cast<std::size_t>(fill[c]++)] = static_cast<int>(r);
+      }
+  std::vector<int> side(n, 0), stamp(n, 0), order;
+  order.reserve(n);
+  std::vector<int> all(n);
+  for (std::size_t v = 0; v < n; ++v) all[v] = static_cast<int>(v);
+  Dissection{start, adjacent, coordinates, side, stamp, order}.run(std::move(all));
+  return order;
+}
+
+LaplacianFactor::LaplacianFactor(const Eigen::SparseMatrix<double>& laplacian,
+                                 const Eigen::Matrix3Xd& coordinates)
+    : order_(nested_dissection_order(laplacian, coordinates)) {
+  const auto n = static_cast<std::size_t>(laplacian.rows());
+  std::vector<int> position(n);
+  for (std::size_t k = 0; k < n; ++k)
+    position[static_cast<std::size_t>(order_[k])] = static_cast<int>(k);
+  // P L P^T, lower triangle again.
+  std::vector<Eigen::Triplet<double>> triplets;
+  triplets.reserve(static_cast<std::size_t>(laplacian.nonZeros()));
+  for (Eigen::Index col = 0; col < laplacian.outerSize(); ++col)
+    for (Eigen::SparseMatrix<double>::InnerIterator it(laplacian, col); it; ++it) {
+      const int a = position[static_cast<std::size_t>(it.row())];
+      const int b = position[static_cast<std::size_t>(col)];
+      triplets.emplace_back(std::max(a, b), std::min(a, b), it.value());
+    }
+  Eigen::SparseMatrix<double> permuted(laplacian.rows(), laplacian.cols());
+  permuted.setFromTriplets(triplets.begin(), triplets.end());
+  factor_.compute(permuted);
+  bool positive = factor_.info() == Eigen::Success;
+  const Eigen::VectorXd& pivots = factor_.vectorD();
   for (Eigen::Index k = 0; positive && k < pivots.size(); ++k) positive = pivots[k] > 0.0;
   if (!positive)
     throw NumericalError(kName,
                          "the spring Laplacian of the interior particles is singular (an interior "
                          "part of the grid is not connected to the boundary)");
+}
+
+Eigen::VectorXd LaplacianFactor::solve(const Eigen::VectorXd& b) const {
+  const Eigen::Index n = size();
+  Eigen::VectorXd permuted(n);
+  for (Eigen::Index k = 0; k < n; ++k) permuted[k] = b[order_[static_cast<std::size_t>(k)]];
+  const Eigen::VectorXd y = factor_.solve(permuted);
+  Eigen::VectorXd x(n);
+  for (Eigen::Index k = 0; k < n; ++k) x[order_[static_cast<std::size_t>(k)]] = y[k];
+  return x;
+}
+
+Eigen::VectorXd LaplacianFactor::solve3(const Eigen::VectorXd& b) const {
+  const Eigen::Index n = size();
+  Eigen::VectorXd r(3 * n);
+  const auto solve_column = [&](int c) { r.segment(c * n, n) = solve(b.segment(c * n, n)); };
+  // Independent const solves of one factor; each column's arithmetic is the same either way.
+  if (n >= 20000) {
+    tbb::parallel_for(0, 3, solve_column);
+  } else {
+    for (int c = 0; c < 3; ++c) solve_column(c);
+  }
+  return r;
 }
 
 double boundary_residual(const RelaxationProblem& problem, const Eigen::Matrix3Xd& positions) {

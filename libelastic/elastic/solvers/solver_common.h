@@ -50,11 +50,43 @@ double tangential_norm(const RelaxationSetup& setup, const Eigen::Matrix3Xd& gra
 Eigen::SparseMatrix<double> interior_laplacian(const RelaxationSetup& setup,
                                                const RelaxationOptions& options);
 
-/// Factorises `laplacian` into `factor` (sparse LDL^T with AMD ordering).
-/// \throws NumericalError when a pivot is not positive: an interior part of the grid is not
-///         connected to the boundary by springs, so it could drift freely.
-void factorize(const Eigen::SparseMatrix<double>& laplacian,
-               Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>>& factor);
+/// 3 x num_free(): the current positions of the interior particles, in interior order.
+Eigen::Matrix3Xd interior_coordinates(const RelaxationSetup& setup);
+
+/// A fill-reducing ordering of the interior particles by geometric nested dissection: the
+/// particles (columns of `coordinates`, n = laplacian.rows()) are split at the median of the
+/// longest axis of their bounding box; the particles of the lower half that have a neighbour in the
+/// upper half (in the sparsity graph of `laplacian`, lower triangle stored) form the separator,
+/// numbered last; both halves are ordered recursively, down to leaves of 64 particles kept in their
+/// given order. On a grid of n particles this gives the O(n log n) fill and O(n^1.5) work of nested
+/// dissection [George 1973], against the larger constants of minimum degree on 2D meshes.
+/// Returns `order`: order[k] = the particle placed at position k. Deterministic (ties broken by
+/// index).
+std::vector<int> nested_dissection_order(const Eigen::SparseMatrix<double>& laplacian,
+                                         const Eigen::Matrix3Xd& coordinates);
+
+/// The interior spring Laplacian, reordered by nested_dissection_order and factorised (sparse
+/// LDL^T, no further ordering); solves with the original numbering.
+class LaplacianFactor {
+ public:
+  /// `laplacian`: lower triangle stored (interior_laplacian); `coordinates`: 3 x n positions of the
+  /// interior particles, used only for the ordering.
+  /// \throws NumericalError when a pivot is not positive: an interior part of the grid is not
+  ///         connected to the boundary by springs, so it could drift freely.
+  LaplacianFactor(const Eigen::SparseMatrix<double>& laplacian,
+                  const Eigen::Matrix3Xd& coordinates);
+  /// L^-1 b for one right-hand side of n entries.
+  Eigen::VectorXd solve(const Eigen::VectorXd& b) const;
+  /// L^-1 for the three n-blocks of b (x, y, z); the three solves run in parallel on large
+  /// systems, each with the same arithmetic as solve().
+  Eigen::VectorXd solve3(const Eigen::VectorXd& b) const;
+  Eigen::Index size() const { return static_cast<Eigen::Index>(order_.size()); }
+
+ private:
+  std::vector<int> order_;
+  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>, Eigen::Lower, Eigen::NaturalOrdering<int>>
+      factor_;
+};
 
 /// Fills the final measurements of `result` from the setup's current positions, points and normals:
 /// energies, tangential gradient (relative to `initial_gradient_norm`), folds, boundary residual,
