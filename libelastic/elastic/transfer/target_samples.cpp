@@ -243,15 +243,21 @@ TargetSamples sample_target(const Region& region, const Mapping& mapping,
     levels = options.max_levels;
     out.limited = true;
   }
-  // Vertex count after each level: V' = V + E, E' = 2E + 3T, T' = 4T (Euler on the disk).
+  // Vertex count after each level: V' = V + E, E' = 2E + 3T, T' = 4T (Euler on the disk). More
+  // levels while below min_vertices; fewer when above max_vertices.
   {
     long v = static_cast<long>(region.points.size());
     long t = region.num_triangles();
     long e = (3 * t + loop_size) / 2;
-    for (int l = 0; l < levels; ++l) {
-      if (v + e > options.max_vertices) {
+    for (int l = 0;; ++l) {
+      const bool wanted = l < levels || (v < options.min_vertices && l < options.max_levels);
+      if (!wanted) {
         levels = l;
-        out.limited = true;
+        break;
+      }
+      if (v + e > options.max_vertices) {
+        out.limited = out.limited || l < levels;
+        levels = l;
         break;
       }
       v += e;

@@ -17,7 +17,8 @@
 ///  - every 3D edge of the target triangles is at most `max_edge`, and
 ///  - every edge of the triangles' image on the source (the chord between the source points of the
 ///    corners) is at most `max_source_edge` (e.g. one source texel, see source_texel_length()),
-/// capped by `max_levels` and `max_vertices`.
+/// and then more levels while the vertex count is below `min_vertices`, capped by `max_levels` and
+/// `max_vertices`.
 ///
 /// For every vertex: its target SurfacePoint, limit position, unit limit normal, and its source
 /// location `mapping.inverse(point)`. Vertices the inverse reports outside are resolved honestly:
@@ -66,6 +67,9 @@ struct TargetSamplingOptions {
   double max_source_edge = 0.0;
   /// Upper bound on the refinement levels (each multiplies the triangle count by 4). 0..12.
   int max_levels = 8;
+  /// Refine (within max_levels and max_vertices) at least until the region has this many vertices,
+  /// e.g. for a smooth per-vertex colour mesh. 0: no lower bound.
+  long min_vertices = 0;
   /// Upper bound on the refined vertex count: fewer levels are used when the next would exceed it
   /// (reported by `limited`).
   long max_vertices = 4'000'000;

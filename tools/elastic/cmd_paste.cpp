@@ -1,0 +1,368 @@
+// `elastic paste`: map the source region onto the target region (the `elastic map` flags), then
+// carry the source's colour (and optionally height and geometric detail) across and write the
+// outputs: the textured decal (OBJ + MTL + PNG), the per-vertex colour PLY, the target texture
+// with the region baked in, the displaced mesh, the pasted detail.
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <nlohmann/json.hpp>
+
+#include "cli_common.h"
+#include "command.h"
+#include "elastic/core/error.h"
+#include "elastic/image/image.h"
+#include "elastic/mesh/mesh_io.h"
+#include "elastic/regions/texture_coordinates.h"
+#include "elastic/transfer/bake.h"
+#include "elastic/transfer/color_source.h"
+#include "elastic/transfer/displacement.h"
+#include "elastic/transfer/geometric_detail.h"
+#include "elastic/transfer/painted_surface.h"
+#include "elastic/transfer/tangent_frames.h"
+#include "job_file.h"
+#include "map_job.h"
+
+namespace elastic::cli {
+namespace {
+
+struct PasteArgs {
+  MapJob job;
+  std::string out;                // --out DIR
+  std::string color = "auto";     // --color auto|texture|vertex|none
+  std::string texture;            // --texture IMAGE (the source's texture)
+  int texture_resolution = 0;     // --texture-resolution N (0: off)
+  long min_vertices = 100'000;    // --min-vertices
+  double max_edge = 0.0;          // --max-edge L
+  int resolution = 8;             // --resolution N (target tessellation)
+  int max_levels = 8;             // --max-levels
+  long max_vertices = 2'000'000;  // --max-vertices
+  bool bake = false;              // --bake
+  std::string bake_texture;       // --bake-texture IMAGE (default: the target's map_Kd)
+  double feather = 0.0;           // --feather TEXELS
+  double alpha = 1.0;             // --alpha A
+  std::string height;             // --height IMAGE|luminance
+  double height_scale = 0.1;      // --height-scale
+  double height_zero = 0.0;       // --height-zero
+  double falloff = 0.0;           // --falloff W
+  std::string detail;             // --detail MESH
+  double detail_scale = 1.0;      // --detail-scale
+};
+
+std::filesystem::path first_map_kd(const PolygonMesh& mesh) {
+  for (const Material& m : mesh.materials) {
+    if (!m.diffuse_texture.empty()) return m.diffuse_texture;
+  }
+  return {};
+}
+
+bool same_file(const std::filesystem::path& a, const std::filesystem::path& b) {
+  std::error_code ec;
+  if (std::filesystem::exists(a, ec) && std::filesystem::exists(b, ec)) {
+    return std::filesystem::equivalent(a, b, ec);
+  }
+  return std::filesystem::weakly_canonical(a, ec) == std::filesystem::weakly_canonical(b, ec);
+}
+
+// The output folder exists and accepts a file, checked before the (long) map runs.
+void check_output_folder(const std::filesystem::path& dir) {
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  if (ec) {
+    throw IoError(dir.string(), "cannot create the output folder: " + ec.message(),
+                  IoError::Direction::Write);
+  }
+  const std::filesystem::path probe = dir / ".elastic_paste_probe";
+  {
+    std::ofstream out(probe);
+    if (!out) {
+      throw IoError(dir.string(), "the output folder is not writable", IoError::Direction::Write);
+    }
+  }
+  std::filesystem::remove(probe, ec);
+}
+
+// Checks that need only the input files, before mapping: a colour source that exists, a target
+// texture to bake into, readable height images and detail meshes.
+void check_inputs(const PasteArgs& a) {
+  if (a.color != "auto" && a.color != "texture" && a.color != "vertex" && a.color != "none") {
+    throw UsageError("--color must be auto, texture, vertex or none, not '" + a.color + "'");
+  }
+  if (!(a.alpha >= 0.0 && a.alpha <= 1.0)) throw UsageError("--alpha must be in [0, 1]");
+  if (!(a.feather >= 0.0)) throw UsageError("--feather must be >= 0 (texels)");
+  if (!(a.max_edge >= 0.0)) throw UsageError("--max-edge must be >= 0");
+  if (!a.texture.empty() && !std::filesystem::exists(a.texture)) {
+    throw IoError(a.texture, "no such file (--texture)");
+  }
+  if (a.color == "texture" && a.job.source_image.empty() && a.texture.empty()) {
+    const PolygonMesh source = read_mesh(a.job.source).mesh;
+    if (!source.has_texcoords()) {
+      throw InvalidInputError(a.job.source,
+                              "has no texture coordinates (needed for --color texture)");
+    }
+    if (first_map_kd(source).empty()) {
+      throw InvalidInputError(a.job.source,
+                              "has no material texture (map_Kd); give one with --texture");
+    }
+  }
+  if (a.color == "vertex" && !a.job.source.empty() && a.job.source_image.empty()) {
+    if (!read_mesh(a.job.source).mesh.has_vertex_colors()) {
+      throw InvalidInputError(a.job.source,
+                              "has no per-vertex colours (needed for --color vertex)");
+    }
+  }
+  if (a.bake) {
+    const PolygonMesh target = read_mesh(a.job.target).mesh;
+    if (!target.has_texcoords()) {
+      throw InvalidInputError(a.job.target, "has no texture coordinates to bake into (--bake)");
+    }
+    const std::filesystem::path image =
+        a.bake_texture.empty() ? first_map_kd(target) : std::filesystem::path(a.bake_texture);
+    if (image.empty()) {
+      throw InvalidInputError(a.job.target,
+                              "has no material texture (map_Kd) to bake into; give --bake-texture");
+    }
+    if (!std::filesystem::exists(image))
+      throw IoError(image.string(), "no such file (bake texture)");
+    if (same_file(image, std::filesystem::path(a.out) / "baked.png")) {
+      throw UsageError("--out would overwrite the target's texture " + image.string() +
+                       " with baked.png; choose another folder");
+    }
+  }
+  if (!a.height.empty() && a.height != "luminance" && !std::filesystem::exists(a.height)) {
+    throw IoError(a.height, "no such file (--height)");
+  }
+  if (!a.detail.empty() && !std::filesystem::exists(a.detail)) {
+    throw IoError(a.detail, "no such file (--detail)");
+  }
+}
+
+// The colour source the flags ask for (nullopt for --color none, or auto without colour).
+std::optional<ColorSource> make_color_source(const PasteArgs& a, const LimitSurface& source) {
+  const PolygonMesh& mesh = source.control_mesh();
+  const bool texture_possible =
+      mesh.has_texcoords() && (!a.texture.empty() || !first_map_kd(mesh).empty());
+  std::string kind = a.color;
+  if (kind == "auto") {
+    kind = texture_possible ? "texture" : mesh.has_vertex_colors() ? "vertex" : "none";
+  }
+  if (kind == "texture") return ColorSource::texture(source, a.texture);
+  if (kind == "vertex") return ColorSource::vertex_colors(source);
+  return std::nullopt;
+}
+
+int run_paste(const PasteArgs& a, const CLI::App& sub) {
+  require_flag(a.out, "--out");
+  require_flag(a.job.target, "--target");
+  const auto start = std::chrono::steady_clock::now();
+  const std::filesystem::path dir(a.out);
+  check_inputs(a);
+  check_output_folder(dir);
+
+  const std::unique_ptr<MapSession> session = run_map_job(a.job, terminal_progress(a.job.quiet));
+  end_progress_line();
+  const MapResult& result = session->result;
+  const LimitSurface& source = *session->source.surface;
+  const LimitSurface& target = *session->target.surface;
+  nlohmann::json report = map_report(a.job, *session, job_of(sub));
+  std::vector<std::filesystem::path> files;
+
+  const std::optional<ColorSource> colors = make_color_source(a, source);
+
+  // The painted target: the target tessellation cut along the region, the region refined so that
+  // a source texel (or --max-edge) is not averaged away.
+  PaintedSurfaceOptions options;
+  options.resolution = a.resolution;
+  options.name = a.job.target;
+  TargetSamplingOptions& sampling = options.sampling;
+  sampling.source_region = &session->source_region;
+  sampling.source_particles = result.sampling.grid.source_positions();
+  sampling.target_particles = result.relaxation.positions;
+  sampling.max_edge = a.max_edge;
+  sampling.max_levels = a.max_levels;
+  sampling.max_vertices = a.max_vertices;
+  sampling.min_vertices = a.min_vertices;
+  if (a.texture_resolution > 0) {
+    // About one source texel per refined edge: a texture of that size is not averaged away by
+    // the per-vertex colours.
+    sampling.max_source_edge =
+        source_texel_length(session->source_region, a.texture_resolution, a.texture_resolution);
+    if (sampling.max_source_edge == 0.0) {
+      throw InvalidInputError(source.name(), "has no texture coordinates (--texture-resolution)");
+    }
+  }
+  const auto paint_start = std::chrono::steady_clock::now();
+  const PaintedSurface painted =
+      paint_surface(target, session->target_region, result.mapping, options);
+  const TargetSamples& samples = painted.samples;
+
+  nlohmann::json paste;
+  paste["levels"] = samples.levels;
+  paste["limited"] = samples.limited;
+  paste["region_vertices"] = samples.num_vertices();
+  paste["region_triangles"] = samples.num_triangles();
+  paste["mesh_vertices"] = painted.num_vertices();
+  paste["mesh_triangles"] = painted.num_triangles();
+  paste["max_edge_length"] = samples.max_edge_length;
+  paste["max_source_edge_length"] = samples.max_source_edge_length;
+  paste["boundary_by_arc_length"] = samples.boundary_by_arc_length;
+  paste["nudged"] = samples.nudged;
+  paste["unresolved"] = samples.unresolved;
+  paste["color"] = !colors                                           ? "none"
+                   : colors->kind() == ColorSourceKind::Texture      ? "texture"
+                   : colors->kind() == ColorSourceKind::VertexColors ? "vertex"
+                                                                     : "scalar";
+
+  if (colors) {
+    if (colors->kind() == ColorSourceKind::Texture) {
+      for (const auto& f : write_decal(dir / "painted.obj", painted, *colors)) files.push_back(f);
+    }
+    write_mesh(dir / "colors.ply", make_colored_mesh(painted, *colors));
+    files.push_back(dir / "colors.ply");
+    if (a.bake) {
+      const std::filesystem::path input = a.bake_texture.empty()
+                                              ? first_map_kd(target.control_mesh())
+                                              : std::filesystem::path(a.bake_texture);
+      BakeOptions bake;
+      bake.alpha = static_cast<float>(a.alpha);
+      bake.feather = a.feather;
+      bake.name = input.string();
+      const BakeResult baked = bake_texture(samples, target, *colors, read_image(input), bake);
+      const std::filesystem::path out = dir / "baked.png";
+      if (same_file(out, input))
+        throw UsageError("refusing to overwrite the input texture " + input.string());
+      write_png(out, baked.image);
+      files.push_back(out);
+      paste["texels_painted"] = baked.texels_painted;
+      paste["texels_changed"] = baked.texels_changed;
+    }
+  } else if (a.bake) {
+    throw InvalidInputError(a.job.source.empty() ? a.job.source_image : a.job.source,
+                            "has no colour to bake (no texture, no vertex colours)");
+  }
+
+  if (!a.height.empty()) {
+    // One height per region vertex: from a height image indexed by the source's texture
+    // coordinates, or from the colour source's luminance.
+    std::vector<double> heights(static_cast<size_t>(samples.num_vertices()),
+                                std::numeric_limits<double>::quiet_NaN());
+    HeightImageOptions himage;
+    himage.zero_level = a.height_zero;
+    if (a.height == "luminance") {
+      if (!colors) throw InvalidInputError("--height", "luminance needs a colour source");
+      for (int i = 0; i < samples.num_vertices(); ++i) {
+        if (!samples.sources[static_cast<size_t>(i)].inside) continue;
+        const Eigen::Vector4d c =
+            colors->color(samples.sources[static_cast<size_t>(i)].point).cast<double>();
+        heights[static_cast<size_t>(i)] =
+            0.2126 * c.x() + 0.7152 * c.y() + 0.0722 * c.z() - a.height_zero;
+      }
+    } else {
+      if (!source.control_mesh().has_texcoords()) {
+        throw InvalidInputError(source.name(), "has no texture coordinates to look up --height");
+      }
+      const Image image = read_image(a.height);
+      std::vector<Eigen::Vector2d> uv;
+      std::vector<int> index;
+      for (int i = 0; i < samples.num_vertices(); ++i) {
+        if (!samples.sources[static_cast<size_t>(i)].inside) continue;
+        uv.push_back(texture_coordinate(source, samples.sources[static_cast<size_t>(i)].point));
+        index.push_back(i);
+      }
+      const std::vector<double> h = heights_from_image(image, uv, himage);
+      for (size_t k = 0; k < index.size(); ++k) heights[static_cast<size_t>(index[k])] = h[k];
+    }
+    DisplacementOptions displacement;
+    displacement.scale = a.height_scale;
+    displacement.falloff_width = a.falloff;
+    const DisplacementResult moved = displace_along_normals(
+        samples.positions, samples.normals, heights, samples.triangles, displacement);
+    PolygonMesh mesh;
+    mesh.positions = painted.positions;
+    for (int j = 0; j < samples.num_vertices(); ++j) {
+      mesh.positions[static_cast<size_t>(painted.sample_vertex_index[static_cast<size_t>(j)])] =
+          moved.positions[static_cast<size_t>(j)];
+    }
+    for (const Eigen::Vector3i& t : painted.triangles) mesh.add_face({t[0], t[1], t[2]});
+    write_mesh(dir / "displaced.obj", mesh);
+    files.push_back(dir / "displaced.obj");
+    paste["max_displacement"] = moved.max_displacement;
+  }
+
+  if (!a.detail.empty()) {
+    const PolygonMesh detail_mesh = read_mesh(a.detail).mesh;
+    const DetailField field =
+        extract_detail(*session->source.projector, detail_mesh, {.name = a.detail});
+    const MapDifferential differential(source, target, result);
+    PasteDetailOptions detail;
+    detail.scale = a.detail_scale;
+    const PasteDetailResult pasted = paste_detail(field, result.mapping, differential, detail);
+    write_mesh(dir / "detail.obj", pasted.mesh);
+    files.push_back(dir / "detail.obj");
+    paste["detail_outside"] = pasted.outside;
+    paste["detail_dropped_faces"] = pasted.dropped_faces;
+  }
+
+  paste["seconds"] =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - paint_start).count();
+  report["paste"] = paste;
+  nlohmann::json list = nlohmann::json::array();
+  for (const auto& f : files) list.push_back(f.string());
+  report["files"] = list;
+  const std::string report_path =
+      a.job.report.empty() ? (dir / "report.json").string() : a.job.report;
+  write_report(report_path, report);
+
+  print_map_summary(a.job, *session);
+  if (!a.job.quiet) {
+    std::cout << "paste: " << samples.num_triangles() << " region triangles (" << samples.levels
+              << " refinement levels) in " << painted.num_triangles() << " triangles, "
+              << std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()
+              << " s\n";
+    for (const auto& f : files) std::cout << "  wrote " << f.string() << '\n';
+    std::cout << "  report " << report_path << '\n';
+  }
+  return result.relaxation.converged ? kOk : kNumerical;
+}
+
+}  // namespace
+}  // namespace elastic::cli
+
+ELASTIC_COMMAND(
+    "paste", "Map a source region onto a target region and paste its colour, height or detail",
+    [](CLI::App& sub) {
+      auto a = std::make_shared<elastic::cli::PasteArgs>();
+      elastic::cli::add_map_flags(sub, a->job);
+      sub.add_option("--out", a->out, "Output folder (required)");
+      sub.add_option("--color", a->color, "Colour source: auto, texture, vertex or none");
+      sub.add_option("--texture", a->texture, "The source's texture image (default: its map_Kd)");
+      sub.add_option("--texture-resolution", a->texture_resolution,
+                     "Refine the region to about one source texel of an N x N texture (0: off)");
+      sub.add_option("--max-edge", a->max_edge, "Refine the region to edges at most this long");
+      sub.add_option("--resolution", a->resolution,
+                     "Target tessellation: segments per control edge")
+          ->check(CLI::Range(1, 1024));
+      sub.add_option("--max-levels", a->max_levels, "Most refinement levels")
+          ->check(CLI::Range(0, 12));
+      sub.add_option("--min-vertices", a->min_vertices,
+                     "Refine the region to at least this many vertices (a smooth colour PLY)");
+      sub.add_option("--max-vertices", a->max_vertices, "Most region vertices after refinement");
+      sub.add_flag("--bake", a->bake, "Bake the colour into the target's own texture (baked.png)");
+      sub.add_option("--bake-texture", a->bake_texture,
+                     "Texture to bake into (default: the target's map_Kd); never overwritten");
+      sub.add_option("--feather", a->feather, "Feathered edge of the bake, in texels");
+      sub.add_option("--alpha", a->alpha, "Opacity of the baked colour, 0..1");
+      sub.add_option("--height", a->height,
+                     "Height image (looked up with the source's UVs) or 'luminance' of the colour");
+      sub.add_option("--height-scale", a->height_scale, "Height units -> target length units");
+      sub.add_option("--height-zero", a->height_zero, "The image value that means height 0");
+      sub.add_option("--falloff", a->falloff, "Displacement ramps up over this distance inside");
+      sub.add_option("--detail", a->detail, "Detail mesh over the source surface to paste");
+      sub.add_option("--detail-scale", a->detail_scale, "Multiplies the detail's offsets");
+      sub.footer(
+          "Example:\n  elastic paste --source-image logo.png --target meshes/cap_quads.obj "
+          "--target-region disk:0,0,1,0.5 \\\n      --particles 2000 --out pasted/\n"
+          "writes pasted/painted.obj (+ .mtl, painted_decal.png), pasted/colors.ply and "
+          "pasted/report.json.");
+      return [a, &sub] { return elastic::cli::run_paste(*a, sub); };
+    });
