@@ -54,8 +54,8 @@ struct BaselineOptions {
   /// Largest region (vertices) given to ARAP. When CGAL 5.5's ARAP leaves flipped triangles it runs
   /// MVC_post_processor_3, whose matrix assembly inserts entries one by one into a compressed
   /// sparse matrix (quadratic): a 182,000-vertex region ran for over 20 minutes there. Larger
-  /// regions are refused (InvalidInputError) instead of hanging; coarsen the projector's
-  /// tessellation or raise this.
+  /// regions are refused (NumericalError: the method cannot run on this valid input) instead of
+  /// hanging; coarsen the projector's tessellation or raise this.
   int arap_max_vertices = 50000;
   /// Common correspondence parameters s = i / n sampled on both boundaries to fit the alignment.
   int alignment_samples = 2048;
@@ -85,10 +85,11 @@ struct BaselineResult {
 /// that best matches the boundary correspondence (grid.boundary_parameter: the normalised arc
 /// length from the anchors), and composing source -> plane -> plane -> target. Boundary particles
 /// are placed exactly at their arc-length positions on the target curve (the same positions
-/// ElasticPaint uses) so that every method shares the boundary correspondence. \throws
-/// InvalidInputError naming the grid or a region when it is empty, has no boundary, or a
-///         particle's source point is not in the source region; NumericalError when CGAL fails to
-///         parameterize a region.
+/// ElasticPaint uses) so that every method shares the boundary correspondence.
+/// \throws InvalidInputError naming the grid or a region when it is empty, has no boundary, is not
+///         a disk, or a particle's source point is not in the source region; NumericalError naming
+///         a region when its flattening fails (CGAL's error, or above ARAP's vertex limit). When
+///         both flattenings fail, the source region's error is the one thrown.
 BaselineResult map_baseline(const ParticleGrid& grid, const SurfaceProjector& source,
                             const Region& source_region, const SurfaceProjector& target,
                             const Region& target_region, const BaselineOptions& options = {});

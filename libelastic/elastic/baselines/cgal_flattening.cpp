@@ -224,7 +224,7 @@ CgalFlattening flatten_region_cgal(const Region& region, BaselineKind kind,
         throw InvalidInputError(name, "ARAP needs at least one iteration");
       }
       if (used_vertices > options.arap_max_vertices) {
-        throw InvalidInputError(
+        throw NumericalError(
             name, "region has " + std::to_string(used_vertices) +
                       " vertices, more than ARAP's limit of " +
                       std::to_string(options.arap_max_vertices) +

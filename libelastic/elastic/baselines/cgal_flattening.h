@@ -43,10 +43,10 @@ struct CgalFlattening {
 };
 
 /// Flattens `region` with the CGAL parameterizer of `kind`.
-/// \throws InvalidInputError naming options.name when the region is empty, is not a manifold
-///         topological disk with one boundary loop, or (ARAP) has more than arap_max_vertices
-///         vertices; NumericalError when CGAL
-///         reports a failure (its error message is included).
+/// \throws InvalidInputError naming options.name when the region is empty or is not a manifold
+///         topological disk with one boundary loop. NumericalError naming it when CGAL reports a
+///         failure (its message is included), the result has zero area, or (ARAP) the region has
+///         more than arap_max_vertices vertices.
 CgalFlattening flatten_region_cgal(const Region& region, BaselineKind kind,
                                    const CgalFlatteningOptions& options = {});
 
