@@ -77,14 +77,18 @@ std::string fmt(double v, int digits = 4) {
 // "particles", "paper_seconds", "paper_springs", "why", "extra"}; paths relative to --root.
 nlohmann::json run_case(const nlohmann::json& c, const BenchArgs& args) {
   const std::string name = c.at("name").get<std::string>();
-  nlohmann::json out = {{"name", name},
-                        {"source", c.at("source")},
-                        {"target", c.at("target")},
-                        {"source_region", c.value("source_region", "boundary")},
-                        {"target_region", c.value("target_region", "boundary")},
-                        {"paper_particles", c.value("particles", 0)},
-                        {"paper_seconds", c.value("paper_seconds", nlohmann::json())},
-                        {"paper_springs", c.value("paper_springs", nlohmann::json())}};
+  nlohmann::json out = {
+      {"name", name},
+      {"source", c.at("source")},
+      {"target", c.at("target")},
+      {"source_region", c.value("source_region", "boundary")},
+      {"target_region", c.value("target_region", "boundary")},
+      {"requested_particles", c.value("particles", 0)},
+      // An extra case has no counterpart in the paper.
+      {"paper_particles",
+       c.value("extra", false) ? nlohmann::json() : nlohmann::json(c.value("particles", 0))},
+      {"paper_seconds", c.value("paper_seconds", nlohmann::json())},
+      {"paper_springs", c.value("paper_springs", nlohmann::json())}};
   const fs::path source = fs::path(args.root) / c.at("source").get<std::string>();
   const fs::path target = fs::path(args.root) / c.at("target").get<std::string>();
   for (const fs::path& p : {source, target}) {
@@ -210,9 +214,12 @@ std::string results_markdown(const nlohmann::json& report) {
       s << "skipped: " << c["skipped"].get<std::string>() << " ||||||||\n";
       continue;
     }
-    s << c["particles"] << " (" << c["paper_particles"] << ") | " << c["springs"] << " ("
-      << c["paper_springs"] << ") | " << fmt(c["seconds"].get<double>(), 3) << " | "
-      << c["paper_seconds"] << " | " << c["iterations"] << " | " << c["folds"] << " | "
+    const auto paper = [&](const char* key) {
+      return c[key].is_number() ? c[key].dump() : std::string("–");
+    };
+    s << c["particles"] << " (" << paper("paper_particles") << ") | " << c["springs"] << " ("
+      << paper("paper_springs") << ") | " << fmt(c["seconds"].get<double>(), 3) << " | "
+      << paper("paper_seconds") << " | " << c["iterations"] << " | " << c["folds"] << " | "
       << fmt(c["length_energy"].get<double>()) << " | "
       << fmt(c["symmetric_dirichlet"].get<double>()) << " |\n";
   }

@@ -70,8 +70,9 @@ std::vector<MethodMeasurement> compare_methods(const MapSession& session,
                  {"source_flipped_triangles", b.source_flipped_triangles},
                  {"target_flipped_triangles", b.target_flipped_triangles}};
       out.push_back(std::move(m));
-    } catch (const NumericalError& e) {
-      // A flattening that fails is a result about that baseline, not a failure of the comparison.
+    } catch (const Error& e) {
+      // A baseline that fails or refuses the input (a flattening that fails, a region beyond its
+      // size limit) is a result about that baseline, not a failure of the comparison.
       MethodMeasurement m;
       m.name = name;
       m.error = e.what();
