@@ -71,7 +71,7 @@ TEST(Render, SphereCoversItsAnalyticSilhouetteAndNothingElse) {
   shape.resolution = 48;
   Scene scene;
   scene.objects.push_back({make_sphere(shape), {}});
-  scene.objects[0].look.colors = ColorSource::Plain;
+  scene.objects[0].look.colors = SurfaceColoring::Plain;
   scene.objects[0].look.plain_color = {0.9f, 0.1f, 0.1f};
   const Camera camera = frame_box(bounding_box(scene), {0.3, -0.2, 1.0}, 40.0, 64, 64);
   RenderOptions options;
@@ -174,8 +174,8 @@ TEST(Render, TextureFromAnObjMaterialFileLandsOnItsHalf) {
   const Image image = render(scene, camera);
   EXPECT_TRUE(is_red(image.at(static_cast<int>(project(camera, {-0.5, 0, 0}).pixel.x()), 16)));
   EXPECT_TRUE(is_blue(image.at(static_cast<int>(project(camera, {0.5, 0, 0}).pixel.x()), 16)));
-  // Without a texture the material's Kd shows (ColorSource::Materials), shaded.
-  scene.objects[0].look.colors = ColorSource::Materials;
+  // Without a texture the material's Kd shows (SurfaceColoring::Materials), shaded.
+  scene.objects[0].look.colors = SurfaceColoring::Materials;
   const Image plain = render(scene, camera);
   EXPECT_NEAR(plain.at(16, 16).x(), 0.8f * head_on_light(), 1e-5f);
 }
@@ -222,7 +222,7 @@ TEST(Render, FaceColoursAppearWhereTheirFacesProjectWithLambertShading) {
   for (int f = 0; f < plane.mesh.num_faces(); ++f) {
     plane.mesh.face_colors.emplace_back(0.1f * f, 1.0f - 0.1f * f, 0.5f);
   }
-  plane.look.colors = ColorSource::FaceColors;
+  plane.look.colors = SurfaceColoring::FaceColors;
   scene.objects.push_back(plane);
   const Camera camera = head_on(64);
   const Image image = render(scene, camera);
@@ -244,7 +244,7 @@ TEST(Render, FaceColoursAppearWhereTheirFacesProjectWithLambertShading) {
 TEST(Render, WireframeDarkensTheEdgesOfAGridLyingOnASurface) {
   Scene scene;
   SceneObject plane{grid_plane(1), {}};
-  plane.look.colors = ColorSource::Plain;
+  plane.look.colors = SurfaceColoring::Plain;
   plane.look.plain_color = {1.0f, 1.0f, 1.0f};
   SceneObject grid{grid_plane(4), {}};
   grid.look.surface = false;
@@ -274,7 +274,7 @@ TEST(Render, AGridJustUnderASurfaceShowsAndOneFarBelowIsHidden) {
   const auto luminance_on_line = [](double depth) {
     Scene scene;
     SceneObject plane{grid_plane(1), {}};
-    plane.look.colors = ColorSource::Plain;
+    plane.look.colors = SurfaceColoring::Plain;
     plane.look.plain_color = {1.0f, 1.0f, 1.0f};
     SceneObject grid{grid_plane(4), {}};
     for (Eigen::Vector3d& p : grid.mesh.positions) p.z() = -depth;
@@ -368,11 +368,11 @@ TEST(Render, RejectsInconsistentInput) {
   const Camera camera = head_on(8);
   Scene scene;
   scene.objects.push_back({grid_plane(1), {}});
-  scene.objects[0].look.colors = ColorSource::FaceColors;  // the mesh has none
+  scene.objects[0].look.colors = SurfaceColoring::FaceColors;  // the mesh has none
   EXPECT_THROW(render(scene, camera), InvalidInputError);
-  scene.objects[0].look.colors = ColorSource::Texture;  // no material
+  scene.objects[0].look.colors = SurfaceColoring::Texture;  // no material
   EXPECT_THROW(render(scene, camera), InvalidInputError);
-  scene.objects[0].look.colors = ColorSource::Auto;
+  scene.objects[0].look.colors = SurfaceColoring::Auto;
   scene.objects[0].mesh.face_vertices[2] = 99;  // out of range
   EXPECT_THROW(render(scene, camera), InvalidInputError);
   scene.objects[0].mesh = grid_plane(1);

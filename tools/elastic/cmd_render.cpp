@@ -104,7 +104,7 @@ int run_render(const RenderArgs& args) {
       if (!scene.objects.back().mesh.has_face_colors()) {
         throw InvalidInputError(path, "--heatmap: the mesh has no per-face colours");
       }
-      look.colors = ColorSource::FaceColors;
+      look.colors = SurfaceColoring::FaceColors;
     }
     look.wireframe = args.edges;
   }

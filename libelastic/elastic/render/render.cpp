@@ -83,7 +83,7 @@ class SampleRandom {
 
 struct PreparedObject {
   const SceneObject* object = nullptr;
-  ColorSource source = ColorSource::Plain;
+  SurfaceColoring source = SurfaceColoring::Plain;
   std::vector<Image> loaded_textures;                // when read here
   const std::vector<Image>* textures = nullptr;      // look.textures or loaded_textures
   std::vector<Eigen::Vector3d> vertex_normals;       // unit, or zero where undefined
@@ -165,8 +165,8 @@ void resolve_colors(PreparedObject& prepared, size_t k) {
     bad_object(k, std::to_string(look.textures.size()) + " textures for " +
                       std::to_string(mesh.materials.size()) + " materials");
   }
-  const bool wants_texture = look.colors == ColorSource::Texture ||
-                             (look.colors == ColorSource::Auto && mesh.has_texcoords());
+  const bool wants_texture = look.colors == SurfaceColoring::Texture ||
+                             (look.colors == SurfaceColoring::Auto && mesh.has_texcoords());
   prepared.textures = &look.textures;
   if (wants_texture && look.textures.empty() && has_materials && any_texture_file(mesh)) {
     for (const Material& material : mesh.materials) {
@@ -177,26 +177,26 @@ void resolve_colors(PreparedObject& prepared, size_t k) {
   }
   const bool textured = mesh.has_texcoords() && has_materials && any_texture(*prepared.textures);
   switch (look.colors) {
-    case ColorSource::Auto:
-      prepared.source = textured                   ? ColorSource::Texture
-                        : mesh.has_face_colors()   ? ColorSource::FaceColors
-                        : mesh.has_vertex_colors() ? ColorSource::VertexColors
-                        : has_materials            ? ColorSource::Materials
-                                                   : ColorSource::Plain;
+    case SurfaceColoring::Auto:
+      prepared.source = textured                   ? SurfaceColoring::Texture
+                        : mesh.has_face_colors()   ? SurfaceColoring::FaceColors
+                        : mesh.has_vertex_colors() ? SurfaceColoring::VertexColors
+                        : has_materials            ? SurfaceColoring::Materials
+                                                   : SurfaceColoring::Plain;
       return;
-    case ColorSource::FaceColors:
+    case SurfaceColoring::FaceColors:
       if (!mesh.has_face_colors()) bad_object(k, "has no face colours to show");
       break;
-    case ColorSource::VertexColors:
+    case SurfaceColoring::VertexColors:
       if (!mesh.has_vertex_colors()) bad_object(k, "has no vertex colours to show");
       break;
-    case ColorSource::Texture:
+    case SurfaceColoring::Texture:
       if (!textured) bad_object(k, "has no textured material with texture coordinates to show");
       break;
-    case ColorSource::Materials:
+    case SurfaceColoring::Materials:
       if (!has_materials) bad_object(k, "has no materials to show");
       break;
-    case ColorSource::Plain:
+    case SurfaceColoring::Plain:
       break;
   }
   prepared.source = look.colors;
@@ -430,14 +430,14 @@ class Tracer {
                                 const std::array<double, 3>& b) const {
     const PolygonMesh& mesh = prepared.object->mesh;
     switch (prepared.source) {
-      case ColorSource::FaceColors:
+      case SurfaceColoring::FaceColors:
         return mesh.face_colors[face];
-      case ColorSource::VertexColors: {
+      case SurfaceColoring::VertexColors: {
         Eigen::Vector3f c = Eigen::Vector3f::Zero();
         for (int i = 0; i < 3; ++i) c += static_cast<float>(b[i]) * mesh.vertex_colors[vertex[i]];
         return c;
       }
-      case ColorSource::Texture: {
+      case SurfaceColoring::Texture: {
         const Eigen::Vector3f under = material_color(prepared, face);
         const int m = mesh.face_materials[face];
         if (m < 0 || (*prepared.textures)[m].empty()) return under;
@@ -447,10 +447,10 @@ class Tracer {
         // Straight alpha: the texel covers the material colour by its alpha.
         return texel.head<3>() * texel.w() + under * (1.0f - texel.w());
       }
-      case ColorSource::Materials:
+      case SurfaceColoring::Materials:
         return material_color(prepared, face);
-      case ColorSource::Auto:
-      case ColorSource::Plain:
+      case SurfaceColoring::Auto:
+      case SurfaceColoring::Plain:
         break;
     }
     return prepared.object->look.plain_color;

@@ -45,7 +45,7 @@
 namespace elastic {
 
 /// Which attribute of an object's mesh colours its surface.
-enum class ColorSource {
+enum class SurfaceColoring {
   Auto,          ///< Texture if any face has a textured material and the mesh has texture
                  ///< coordinates, else FaceColors, else VertexColors, else Materials, else Plain
   FaceColors,    ///< PolygonMesh::face_colors (e.g. a per-face distortion heatmap)
@@ -58,8 +58,8 @@ enum class ColorSource {
 /// How one object looks.
 struct ObjectLook {
   /// Which attribute colours the surface; a forced source the mesh lacks is an error.
-  ColorSource colors = ColorSource::Auto;
-  /// The colour of ColorSource::Plain and of faces that have no colour under the chosen source.
+  SurfaceColoring colors = SurfaceColoring::Auto;
+  /// The colour of SurfaceColoring::Plain and of faces that have no colour under the chosen source.
   Eigen::Vector3f plain_color{0.75f, 0.76f, 0.78f};
   /// One image per entry of PolygonMesh::materials (an empty Image for a material without one).
   /// When this vector is empty, render() reads the materials' `diffuse_texture` files itself.
