@@ -162,6 +162,7 @@ TEST(Camera, FrameBoxAvoidsAnUpVectorAlongTheView) {
   const Camera camera = frame_box(box, Eigen::Vector3d::UnitZ(), 30.0, 32, 32);  // up hint is +z
   EXPECT_NO_THROW(camera_frame(camera));
   EXPECT_LT(std::abs(camera.up.dot(Eigen::Vector3d::UnitZ())), 0.5);
+  EXPECT_NEAR(camera_frame(camera).up.y(), 1.0, 1e-12);  // looking down z: y up, as documented
 }
 
 TEST(Camera, RejectsBadInput) {

@@ -27,10 +27,13 @@ void check_fov_and_size(double fov_deg, int width, int height) {
 }
 
 /// The coordinate axis least aligned with `v` (a safe fallback for an up vector parallel to v).
+/// Ties go to y, then z, then x, so a view straight along z gets the usual y-up picture.
 Eigen::Vector3d most_orthogonal_axis(const Eigen::Vector3d& v) {
-  int axis = 0;
-  v.cwiseAbs().minCoeff(&axis);
-  return Eigen::Vector3d::Unit(axis);
+  int best = 1;
+  for (int axis : {2, 0}) {
+    if (std::abs(v[axis]) < std::abs(v[best])) best = axis;
+  }
+  return Eigen::Vector3d::Unit(best);
 }
 
 }  // namespace

@@ -77,9 +77,9 @@ Eigen::Vector3d orbit_view(const Eigen::Vector3d& view, double azimuth_deg, doub
 /// both margins (along the other axis the slack is shared between the sides, so that picture is
 /// nearly centred). Exact (a closed-form minimum; see the .cpp). The camera's up is `up` made
 /// orthogonal to the view, unless the view is within ~8 degrees of `up`; then the coordinate axis
-/// most orthogonal to the view is used instead. A box that is a single point gets the eye at
-/// distance 1. \throws InvalidInputError ("camera") for an empty or non-finite box, a zero or
-/// non-finite view
+/// most orthogonal to the view (ties: y, z, x) is used instead. A box that is a single point gets
+/// the eye at distance 1.
+/// \throws InvalidInputError ("camera") for an empty or non-finite box, a zero or non-finite view
 ///         direction, a field of view outside (0, 180), a non-positive size or fill outside (0, 1].
 Camera frame_box(const Eigen::AlignedBox3d& box, const Eigen::Vector3d& view_direction,
                  double fov_deg, int width, int height, double fill = 0.9,
