@@ -114,10 +114,7 @@ nlohmann::json run_case(const nlohmann::json& c, const BenchArgs& args) {
   std::vector<double> seconds = {session->seconds_total - session->seconds_loading};
   // Further runs map again on the loaded surfaces and regions with the options run_map_job used
   // (the job's defaults: L-BFGS, boundary rest scale, seed 0), so loading is not repeated.
-  MapOptions options;
-  options.sampling.layout.particles = job.particles;
-  options.sampling.layout.name = "--source-region";
-  options.relaxation.threads = job.threads;
+  const MapOptions options = make_map_options(job);
   for (int run = 1; run < args.runs; ++run) {
     if (!args.quiet) std::cerr << "elastic bench: " << name << " run " << run + 1 << "\n";
     const auto start = std::chrono::steady_clock::now();

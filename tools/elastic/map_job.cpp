@@ -83,6 +83,21 @@ void add_map_flags(CLI::App& sub, MapJob& a) {
   sub.add_flag("--quiet,-q", a.quiet, "No progress, no warnings: only results");
 }
 
+MapOptions make_map_options(const MapJob& job, const ProgressCallback& progress) {
+  MapOptions options;
+  options.sampling.layout.particles = job.particles;
+  options.sampling.layout.name = "--source-region";
+  options.sampling.sampling.seed = job.seed;
+  options.rest_scale = parse_rest_scale(job.rest_scale, "--rest-scale");
+  options.relaxation.solver = job.solver == "explicit" ? SolverKind::Faithful : SolverKind::Fast;
+  options.relaxation.threads = job.threads;
+  options.relaxation.max_iterations = job.max_iterations;
+  options.subdivisions = job.subdivide;
+  options.progress = progress;
+  options.relaxation.progress = progress;
+  return options;
+}
+
 std::unique_ptr<MapSession> run_map_job(const MapJob& job, const ProgressCallback& progress) {
   const auto start = std::chrono::steady_clock::now();
   require_flag(job.target, "--target");
@@ -127,17 +142,7 @@ std::unique_ptr<MapSession> run_map_job(const MapJob& job, const ProgressCallbac
   s.target_region = make_region(*s.target.projector, target_spec, {.name = "--target-region"});
   s.seconds_loading = seconds_since(start);
 
-  MapOptions options;
-  options.sampling.layout.particles = job.particles;
-  options.sampling.layout.name = "--source-region";
-  options.sampling.sampling.seed = job.seed;
-  options.rest_scale = parse_rest_scale(job.rest_scale, "--rest-scale");
-  options.relaxation.solver = job.solver == "explicit" ? SolverKind::Faithful : SolverKind::Fast;
-  options.relaxation.threads = job.threads;
-  options.relaxation.max_iterations = job.max_iterations;
-  options.subdivisions = job.subdivide;
-  options.progress = progress;
-  options.relaxation.progress = progress;
+  const MapOptions options = make_map_options(job, progress);
   s.result = map_regions(*s.source.projector, s.source_region, *s.target.projector, s.target_region,
                          options);
   s.seconds_total = seconds_since(start);

@@ -63,6 +63,10 @@ struct MapSession {
   MapSession& operator=(const MapSession&) = delete;
 };
 
+/// The MapOptions a job asks for (what run_map_job passes to map_regions), for commands that
+/// repeat the map (e.g. `bench` timing several runs).
+MapOptions make_map_options(const MapJob& job, const ProgressCallback& progress = {});
+
 /// Validates the job, loads the surfaces and regions, and maps. Progress goes to `progress`
 /// (stage and solver iterations). \throws UsageError / InvalidInputError / IoError naming the flag
 /// or file; NumericalError when a stage fails.
