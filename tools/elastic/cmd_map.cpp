@@ -39,7 +39,7 @@ int run_map(const MapArgs& args, const CLI::App& sub) {
   }
   write_report(args.job.report, report);
   print_map_summary(args.job, *session);
-  return result.relaxation.converged ? kOk : kNumerical;
+  return map_exit_code(*session, args.job.quiet);
 }
 
 }  // namespace

@@ -10,6 +10,7 @@
 
 #include "cli_common.h"
 #include "command.h"
+#include "compare_methods.h"
 #include "elastic/core/error.h"
 #include "elastic/image/image.h"
 #include "elastic/mesh/mesh_io.h"
@@ -22,6 +23,7 @@
 #include "elastic/transfer/tangent_frames.h"
 #include "job_file.h"
 #include "map_job.h"
+#include "paste_preview.h"
 
 namespace elastic::cli {
 namespace {
@@ -47,6 +49,10 @@ struct PasteArgs {
   double falloff = 0.0;           // --falloff W
   std::string detail;             // --detail MESH
   double detail_scale = 1.0;      // --detail-scale
+  bool preview = false;           // --preview
+  int preview_size = 800;         // --preview-size N
+  long frames = 0;                // --frames K (every K-th relaxation iteration)
+  std::string baseline = "none";  // --baseline lscm|arap|dcm|none
 };
 
 std::filesystem::path first_map_kd(const PolygonMesh& mesh) {
@@ -159,7 +165,21 @@ int run_paste(const PasteArgs& a, const CLI::App& sub) {
   check_inputs(a);
   check_output_folder(dir);
 
-  const std::unique_ptr<MapSession> session = run_map_job(a.job, terminal_progress(a.job.quiet));
+  // Relaxation frames for the preview's animation (positions every --frames iterations).
+  std::vector<Eigen::Matrix3Xd> frames;
+  std::vector<long> frame_iterations;
+  FrameCallback frame;
+  if (a.frames > 0) {
+    frame = [&](const RelaxationFrame& f) {
+      constexpr size_t kMostFrames = 64;  // a contact sheet stays readable
+      if (frames.size() < kMostFrames) {
+        frames.push_back(*f.positions);
+        frame_iterations.push_back(f.iteration);
+      }
+    };
+  }
+  const std::unique_ptr<MapSession> session =
+      run_map_job(a.job, terminal_progress(a.job.quiet), frame, a.frames);
   end_progress_line();
   const MapResult& result = session->result;
   const LimitSurface& source = *session->source.surface;
@@ -306,6 +326,58 @@ int run_paste(const PasteArgs& a, const CLI::App& sub) {
   paste["seconds"] =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - paint_start).count();
   report["paste"] = paste;
+
+  // Distortion of the map (docs/metrics.md), and of a baseline on the same grid when asked.
+  CompareOptions compare;
+  compare.baselines.clear();
+  if (a.baseline != "none")
+    compare.baselines.push_back(parse_baseline_kind(a.baseline, "--baseline"));
+  const std::vector<MethodMeasurement> methods = compare_methods(*session, compare);
+  nlohmann::json metrics = nlohmann::json::object();
+  for (const MethodMeasurement& m : methods) metrics[m.name] = measurement_json(m);
+  report["metrics"] = metrics;
+
+  if (a.preview || a.frames > 0) {
+    PolygonMesh surface, outside;
+    surface.positions = painted.positions;
+    outside.positions = painted.positions;
+    for (int t = 0; t < painted.num_triangles(); ++t) {
+      const Eigen::Vector3i& c = painted.triangles[static_cast<size_t>(t)];
+      surface.add_face({c[0], c[1], c[2]});
+      if (!painted.triangle_inside[static_cast<size_t>(t)]) outside.add_face({c[0], c[1], c[2]});
+    }
+    const PreviewWriter preview(
+        session->target_region, std::move(surface), std::move(outside),
+        {.width = a.preview_size, .height = a.preview_size, .threads = a.job.threads});
+    const ParticleGrid& grid = result.sampling.grid;
+    if (a.preview) {
+      const PolygonMesh shown =
+          colors && colors->kind() == ColorSourceKind::Texture
+              ? make_decal_mesh(painted, *colors, {.texture_path = dir / "painted_decal.png"})
+          : colors ? make_colored_mesh(painted, *colors)
+                   : PolygonMesh();
+      if (shown.num_faces() > 0) files.push_back(preview.write_feature(dir / "preview.png", shown));
+      files.push_back(preview.write_grids(dir / "preview_grid.png", grid,
+                                          {&result.naive.positions, &result.relaxation.positions},
+                                          {"naive map", "ElasticPaint"}));
+      std::vector<const Eigen::Matrix3Xd*> positions;
+      std::vector<const MapMetrics*> measured;
+      std::vector<std::string> labels;
+      for (const MethodMeasurement& m : methods) {
+        if (!m.ok || m.name == "naive") continue;
+        positions.push_back(&m.positions);
+        measured.push_back(&m.metrics);
+        labels.push_back(m.name == "elastic" ? "ElasticPaint" : m.name);
+      }
+      files.push_back(
+          preview.write_heatmaps(dir / "preview_heatmap.png", positions, measured, labels));
+    }
+    if (!frames.empty()) {
+      for (const auto& f : preview.write_frames(dir / "frames", grid, frames, frame_iterations)) {
+        files.push_back(f);
+      }
+    }
+  }
   nlohmann::json list = nlohmann::json::array();
   for (const auto& f : files) list.push_back(f.string());
   report["files"] = list;
@@ -322,7 +394,15 @@ int run_paste(const PasteArgs& a, const CLI::App& sub) {
     for (const auto& f : files) std::cout << "  wrote " << f.string() << '\n';
     std::cout << "  report " << report_path << '\n';
   }
-  return result.relaxation.converged ? kOk : kNumerical;
+  // The headline: distortion against the baseline on the same grid.
+  for (const MethodMeasurement& m : methods) {
+    if (!m.ok || m.name == "naive") continue;
+    std::cout << (m.name == "elastic" ? "ElasticPaint" : m.name) << ": length energy "
+              << m.metrics.length_energy << ", symmetric Dirichlet "
+              << m.metrics.symmetric_dirichlet << ", stretch L2 " << m.metrics.stretch_l2
+              << ", folds " << m.metrics.folds << ", " << m.seconds << " s\n";
+  }
+  return map_exit_code(*session, a.job.quiet);
 }
 
 }  // namespace
@@ -359,6 +439,17 @@ ELASTIC_COMMAND(
       sub.add_option("--falloff", a->falloff, "Displacement ramps up over this distance inside");
       sub.add_option("--detail", a->detail, "Detail mesh over the source surface to paste");
       sub.add_option("--detail-scale", a->detail_scale, "Multiplies the detail's offsets");
+      sub.add_flag("--preview", a->preview,
+                   "Render preview.png (the feature), preview_grid.png (naive vs relaxed grid) "
+                   "and preview_heatmap.png (distortion, beside --baseline)");
+      sub.add_option("--preview-size", a->preview_size, "Preview pictures are N x N pixels")
+          ->check(CLI::Range(64, 4096));
+      sub.add_option("--frames", a->frames,
+                     "Render every K-th relaxation iteration to frames/ with a contact sheet")
+          ->check(CLI::Range(0L, 1000000L));
+      sub.add_option("--baseline", a->baseline,
+                     "Also measure this baseline on the same grid (report, heatmap, headline)")
+          ->check(CLI::IsMember({"none", "lscm", "arap", "dcm"}));
       sub.footer(
           "Example:\n  elastic paste --source-image logo.png --target meshes/cap_quads.obj "
           "--target-region disk:0,0,1,0.5 \\\n      --particles 2000 --out pasted/\n"

@@ -1,10 +1,12 @@
 #include "map_job.h"
 
+#include <algorithm>
 #include <chrono>
 #include <fstream>
 #include <iostream>
 #include <sstream>
 
+#include "command.h"
 #include "elastic/core/atomic_file.h"
 #include "elastic/core/error.h"
 #include "elastic/regions/region_spec.h"
@@ -98,7 +100,8 @@ MapOptions make_map_options(const MapJob& job, const ProgressCallback& progress)
   return options;
 }
 
-std::unique_ptr<MapSession> run_map_job(const MapJob& job, const ProgressCallback& progress) {
+std::unique_ptr<MapSession> run_map_job(const MapJob& job, const ProgressCallback& progress,
+                                        const FrameCallback& frame, long frame_interval) {
   const auto start = std::chrono::steady_clock::now();
   require_flag(job.target, "--target");
   if (job.particles < 16 || job.particles > 5'000'000) {
@@ -142,7 +145,9 @@ std::unique_ptr<MapSession> run_map_job(const MapJob& job, const ProgressCallbac
   s.target_region = make_region(*s.target.projector, target_spec, {.name = "--target-region"});
   s.seconds_loading = seconds_since(start);
 
-  const MapOptions options = make_map_options(job, progress);
+  MapOptions options = make_map_options(job, progress);
+  options.relaxation.frame = frame;
+  options.relaxation.frame_interval = std::max(1L, frame_interval);
   s.result = map_regions(*s.source.projector, s.source_region, *s.target.projector, s.target_region,
                          options);
   s.seconds_total = seconds_since(start);
@@ -189,6 +194,21 @@ nlohmann::json map_report(const MapJob& job, const MapSession& session,
             {"spacing_median", s.spacing_median},
             {"spacing_max", s.spacing_max},
             {"density_ratio", s.density_ratio}}}};
+}
+
+int map_exit_code(const MapSession& session, bool quiet) {
+  const RelaxationResult& x = session.result.relaxation;
+  if (x.converged) return kOk;
+  if (x.reason == StopReason::FoldConstrained && x.folded_faces == 0) {
+    if (!quiet) {
+      std::cerr << "elastic: note: the relaxation stopped at its no-fold constraint: "
+                << x.held_particles.size()
+                << " particles are held where moving on would fold a face (the true minimum "
+                   "folds); all others are at equilibrium, and the map has no folds\n";
+    }
+    return kOk;
+  }
+  return kNumerical;
 }
 
 void write_report(const std::string& path, const nlohmann::json& report) {

@@ -70,7 +70,9 @@ MapOptions make_map_options(const MapJob& job, const ProgressCallback& progress 
 /// Validates the job, loads the surfaces and regions, and maps. Progress goes to `progress`
 /// (stage and solver iterations). \throws UsageError / InvalidInputError / IoError naming the flag
 /// or file; NumericalError when a stage fails.
-std::unique_ptr<MapSession> run_map_job(const MapJob& job, const ProgressCallback& progress = {});
+/// `frame` (optional) receives every `frame_interval`-th configuration of the relaxation.
+std::unique_ptr<MapSession> run_map_job(const MapJob& job, const ProgressCallback& progress = {},
+                                        const FrameCallback& frame = {}, long frame_interval = 1);
 
 /// The report of `elastic map` (keys in docs/getting-started.md) with `job` recorded under "job".
 nlohmann::json map_report(const MapJob& job, const MapSession& session,
@@ -81,6 +83,12 @@ void write_report(const std::string& path, const nlohmann::json& report);
 
 /// The two-line summary `elastic map` prints.
 void print_map_summary(const MapJob& job, const MapSession& session);
+
+/// The exit code of a map run: 0 when the solver converged, or when it stopped at the no-fold
+/// constraint (FoldConstrained) with zero folds (the map is usable: every particle but the held
+/// ones is at equilibrium; a note on stderr says so unless quiet); 70 (numerical failure)
+/// otherwise.
+int map_exit_code(const MapSession& session, bool quiet);
 
 /// Parses "X,Y,Z" (finite numbers). \throws InvalidInputError naming `flag`.
 Eigen::Vector3d parse_point(const std::string& text, const std::string& flag);

@@ -1,0 +1,148 @@
+#include "paste_preview.h"
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <utility>
+
+#include "elastic/image/image.h"
+#include "elastic/metrics/heatmap.h"
+#include "elastic/render/compose.h"
+#include "elastic/render/render.h"
+
+namespace elastic::cli {
+namespace {
+
+constexpr double kFieldOfView = 35.0;  // degrees: a mild perspective
+constexpr double kFill = 0.8;          // the region fills 80% of the picture
+
+RenderOptions render_options(const PreviewSettings& settings) {
+  RenderOptions options;
+  options.threads = settings.threads;
+  return options;
+}
+
+SceneObject surface_object(PolygonMesh mesh) {
+  SceneObject object;
+  object.mesh = std::move(mesh);
+  object.look.colors = SurfaceColoring::Plain;
+  return object;
+}
+
+SceneObject grid_object(const ParticleGrid& grid, const Eigen::Matrix3Xd& positions) {
+  SceneObject object;
+  object.mesh = to_polygon_mesh(grid, positions);
+  object.look.surface = false;
+  object.look.wireframe = true;
+  object.look.wire_width_px = 1.0;
+  return object;
+}
+
+}  // namespace
+
+Camera region_camera(const Region& region, int width, int height) {
+  Eigen::Vector3d normal = Eigen::Vector3d::Zero();
+  for (const Eigen::Vector3i& t : region.triangles) {
+    const Eigen::Vector3d& a = region.positions[static_cast<size_t>(t[0])];
+    normal += (region.positions[static_cast<size_t>(t[1])] - a)
+                  .cross(region.positions[static_cast<size_t>(t[2])] - a);
+  }
+  if (normal.norm() == 0.0) normal = Eigen::Vector3d::UnitZ();
+  normal.normalize();
+  // A view straight along a vertical normal looks flat: tilt it towards the viewer a little.
+  Eigen::Vector3d view = normal;
+  if (std::abs(normal.z()) > 0.9) view = (normal + Eigen::Vector3d(0.0, -0.5, 0.0)).normalized();
+  return frame_points(region.positions, view, kFieldOfView, width, height, kFill);
+}
+
+PreviewWriter::PreviewWriter(const Region& target_region, PolygonMesh target_surface,
+                             PolygonMesh target_outside, const PreviewSettings& settings)
+    : camera_(region_camera(target_region, settings.width, settings.height)),
+      small_camera_(region_camera(target_region, std::max(64, settings.width / 2),
+                                  std::max(64, settings.height / 2))),
+      surface_(std::move(target_surface)),
+      outside_(std::move(target_outside)),
+      settings_(settings) {}
+
+std::filesystem::path PreviewWriter::write_feature(const std::filesystem::path& png,
+                                                   const PolygonMesh& painted) const {
+  SceneObject object;
+  object.mesh = painted;
+  object.look.textures = load_material_textures(painted).images;
+  Scene scene;
+  scene.objects.push_back(std::move(object));
+  write_png(png, render(scene, camera_, render_options(settings_)));
+  return png;
+}
+
+std::filesystem::path PreviewWriter::write_grids(
+    const std::filesystem::path& png, const ParticleGrid& grid,
+    const std::vector<const Eigen::Matrix3Xd*>& positions,
+    const std::vector<std::string>& labels) const {
+  std::vector<Image> pictures;
+  for (const Eigen::Matrix3Xd* p : positions) {
+    Scene scene;
+    scene.objects.push_back(surface_object(surface_));
+    scene.objects.push_back(grid_object(grid, *p));
+    pictures.push_back(render(scene, camera_, render_options(settings_)));
+  }
+  write_png(png, side_by_side(pictures, labels));
+  return png;
+}
+
+std::filesystem::path PreviewWriter::write_heatmaps(
+    const std::filesystem::path& png, const std::vector<const Eigen::Matrix3Xd*>& positions,
+    const std::vector<const MapMetrics*>& metrics, const std::vector<std::string>& labels) const {
+  // One colour range for all: from the perfect value (green) to the largest of the methods'
+  // automatic highs (their 95th percentiles), so the worst method's bulk is red.
+  HeatmapOptions shared;
+  for (size_t k = 0; k < positions.size(); ++k) {
+    const HeatmapResult own = make_heatmap(*positions[k], *metrics[k], {});
+    shared.low = own.low;
+    shared.high = std::max(shared.high.value_or(own.high), own.high);
+  }
+  std::vector<Image> pictures;
+  for (size_t k = 0; k < positions.size(); ++k) {
+    const HeatmapResult heat = make_heatmap(*positions[k], *metrics[k], shared);
+    Scene scene;
+    if (outside_.num_faces() > 0) scene.objects.push_back(surface_object(outside_));
+    SceneObject object;
+    object.mesh = heat.mesh;
+    object.look.colors = SurfaceColoring::FaceColors;
+    scene.objects.push_back(std::move(object));
+    pictures.push_back(render(scene, camera_, render_options(settings_)));
+  }
+  write_png(png, side_by_side(pictures, labels));
+  return png;
+}
+
+std::vector<std::filesystem::path> PreviewWriter::write_frames(
+    const std::filesystem::path& dir, const ParticleGrid& grid,
+    const std::vector<Eigen::Matrix3Xd>& frames, const std::vector<long>& iterations) const {
+  std::filesystem::create_directories(dir);
+  std::vector<std::filesystem::path> written;
+  std::vector<Image> pictures;
+  std::vector<std::string> labels;
+  for (size_t k = 0; k < frames.size(); ++k) {
+    Scene scene;
+    scene.objects.push_back(surface_object(surface_));
+    scene.objects.push_back(grid_object(grid, frames[k]));
+    Image picture = render(scene, small_camera_, render_options(settings_));
+    char name[32];
+    std::snprintf(name, sizeof name, "frame_%04zu.png", k + 1);
+    write_png(dir / name, picture);
+    written.push_back(dir / name);
+    pictures.push_back(std::move(picture));
+    labels.push_back(std::to_string(iterations[k]));
+  }
+  if (!pictures.empty()) {
+    const int columns =
+        static_cast<int>(std::ceil(std::sqrt(static_cast<double>(pictures.size()))));
+    write_png(dir / "contact_sheet.png", contact_sheet(pictures, columns, labels));
+    written.push_back(dir / "contact_sheet.png");
+  }
+  return written;
+}
+
+}  // namespace elastic::cli
