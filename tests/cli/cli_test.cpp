@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <set>
 #include <sstream>
 #include <string>
 
@@ -148,6 +149,43 @@ TEST(Cli, JobFileRepeatsTheRunAndFlagsWin) {
   expect_error(elastic("map --job " + (dir / "other.json").string(), dir), 64, "other.json");
   std::ofstream(dir / "junk.json") << "{ not json";
   expect_error(elastic("map --job " + (dir / "junk.json").string(), dir), 65, "junk.json");
+}
+
+TEST(Cli, PasteWritesEveryFileItListsAndRefusesColourlessSources) {
+  const fs::path dir = test::scratch_dir("cli_paste");
+  const std::string emblem = (dir / "emblem.png").string();
+  ASSERT_EQ(elastic("render --emblem " + emblem + " --size 64 --quiet", dir).code, 0);
+  const fs::path out = dir / "out";
+  const CliRun run =
+      elastic("paste -q --source-image " + emblem + " --source-region ellipse --target " +
+                  mesh("cap_quads.obj") + " --target-region disk:0,0,1,0.5 --particles 200 --out " +
+                  out.string() +
+                  " --preview --preview-size 64 --frames 5 --baseline dcm "
+                  "--min-vertices 2000",
+              dir);
+  ASSERT_EQ(run.code, 0) << run.err;
+  const nlohmann::json report = nlohmann::json::parse(std::ifstream(out / "report.json"));
+  // Every listed file exists and is not empty; the expected kinds are all there.
+  std::set<std::string> names;
+  for (const auto& file : report["files"]) {
+    const fs::path path = file.get<std::string>();
+    EXPECT_TRUE(fs::exists(path) && fs::file_size(path) > 0) << path;
+    names.insert(path.filename().string());
+  }
+  for (const char* expected :
+       {"painted.obj", "painted.mtl", "painted_decal.png", "colors.ply", "heatmap.ply",
+        "preview.png", "preview_grid.png", "preview_heatmap.png", "contact_sheet.png"}) {
+    EXPECT_TRUE(names.count(expected)) << expected;
+  }
+  // The map's metrics and the baseline's, on the same grid.
+  EXPECT_EQ(report["metrics"]["elastic"]["folds"], 0);
+  EXPECT_TRUE(report["metrics"].contains("dcm"));
+  EXPECT_GE(report["metrics"]["elastic"]["symmetric_dirichlet"].get<double>(), 4.0);
+  // A source without texture coordinates has no colour to paste: bad input, named.
+  expect_error(elastic("paste --source " + mesh("plane_quads.obj") + " --color texture --target " +
+                           mesh("cap_quads.obj") + " --out " + (dir / "none").string(),
+                       dir),
+               65, "plane_quads.obj");
 }
 
 TEST(Cli, EverySubcommandHasHelpWithAnExample) {

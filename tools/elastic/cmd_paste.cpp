@@ -336,6 +336,13 @@ int run_paste(const PasteArgs& a, const CLI::App& sub) {
   nlohmann::json metrics = nlohmann::json::object();
   for (const MethodMeasurement& m : methods) metrics[m.name] = measurement_json(m);
   report["metrics"] = metrics;
+  // The distortion heatmap of Fig. 9 (symmetric Dirichlet per grid triangle, green = perfect) as
+  // PLY face and vertex colours.
+  for (const MethodMeasurement& m : methods) {
+    if (m.name != "elastic" || !m.ok) continue;
+    write_mesh(dir / "heatmap.ply", make_heatmap(m.positions, m.metrics).mesh);
+    files.push_back(dir / "heatmap.ply");
+  }
 
   if (a.preview || a.frames > 0) {
     PolygonMesh surface, outside;
@@ -453,7 +460,8 @@ ELASTIC_COMMAND(
       sub.footer(
           "Example:\n  elastic paste --source-image logo.png --target meshes/cap_quads.obj "
           "--target-region disk:0,0,1,0.5 \\\n      --particles 2000 --out pasted/\n"
-          "writes pasted/painted.obj (+ .mtl, painted_decal.png), pasted/colors.ply and "
+          "writes pasted/painted.obj (+ .mtl, painted_decal.png), pasted/colors.ply, "
+          "pasted/heatmap.ply and "
           "pasted/report.json.");
       return [a, &sub] { return elastic::cli::run_paste(*a, sub); };
     });
