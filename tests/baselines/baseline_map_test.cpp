@@ -18,6 +18,7 @@
 #include "elastic/regions/region_spec.h"
 #include "elastic/sampling/sample_region.h"
 #include "elastic/shapes/procedural_shapes.h"
+#include "rigid_motion.h"
 #include "support.h"
 
 namespace elastic {
@@ -37,13 +38,6 @@ struct Surface {
 PolygonMesh transformed(PolygonMesh mesh, const Eigen::Affine3d& motion) {
   for (Eigen::Vector3d& p : mesh.positions) p = motion * p;
   return mesh;
-}
-
-Eigen::Affine3d some_rigid_motion() {
-  Eigen::Affine3d m = Eigen::Affine3d::Identity();
-  m.rotate(Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized()));
-  m.pretranslate(Eigen::Vector3d(0.3, -1.2, 2.5));
-  return m;
 }
 
 ParticleGrid sample(const Region& region, const SurfaceProjector& projector, long particles) {
@@ -110,7 +104,7 @@ TEST(CgalFlattening, PlanarRegionFlattensIsometrically) {
 // nothing outside.
 TEST(MapBaseline, RigidlyMovedCopyGivesTheRigidMotion) {
   const PolygonMesh mesh = make_plane({.resolution = 10});
-  const Eigen::Affine3d motion = some_rigid_motion();
+  const Eigen::Affine3d motion = test::rigid_motion();
   const Surface source(mesh), target(transformed(mesh, motion));
   const Region from = make_region(*source.projector, disk_spec(Eigen::Affine3d::Identity(), 0.6));
   const Region to = make_region(*target.projector, disk_spec(motion, 0.6));

@@ -8,29 +8,18 @@
 
 #include "elastic/regions/region_spec.h"
 #include "elastic/shapes/procedural_shapes.h"
+#include "rigid_motion.h"
 
 namespace elastic {
 namespace {
-
-PolygonMesh moved(PolygonMesh mesh, const Eigen::Isometry3d& motion) {
-  for (Eigen::Vector3d& p : mesh.positions) p = motion * p;
-  return mesh;
-}
-
-Eigen::Isometry3d some_rigid_motion() {
-  Eigen::Isometry3d m = Eigen::Isometry3d::Identity();
-  m.rotate(Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized()));
-  m.pretranslate(Eigen::Vector3d(0.3, -1.2, 2.5));
-  return m;
-}
 
 // A disk on a plane mapped onto the same disk on a rigidly moved copy of the plane: the map must be
 // the rigid motion (the zero of the length and angle energies; congruent regions, congruent
 // anchors).
 TEST(MapRegions, PlaneOntoRigidlyMovedCopyIsTheRigidMotion) {
   const PolygonMesh plane = make_plane({.faces = ShapeFaces::Quads, .resolution = 12});
-  const Eigen::Isometry3d motion = some_rigid_motion();
-  const LimitSurface source_surface(plane), target_surface(moved(plane, motion));
+  const Eigen::Isometry3d motion = test::rigid_motion();
+  const LimitSurface source_surface(plane), target_surface(test::moved(plane, motion));
   const SurfaceProjector source(source_surface), target(target_surface);
   RegionSpec source_spec = parse_region_spec("disk:0.1,0.05,0,0.6");
   source_spec.anchor = Eigen::Vector3d(1, 0, 0);

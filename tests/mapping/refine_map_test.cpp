@@ -9,14 +9,10 @@
 #include "elastic/mapping/map_regions.h"
 #include "elastic/regions/region_spec.h"
 #include "elastic/shapes/procedural_shapes.h"
+#include "rigid_motion.h"
 
 namespace elastic {
 namespace {
-
-PolygonMesh moved(PolygonMesh mesh, const Eigen::Isometry3d& motion) {
-  for (Eigen::Vector3d& p : mesh.positions) p = motion * p;
-  return mesh;
-}
 
 Eigen::Isometry3d some_rigid_motion() {
   Eigen::Isometry3d m = Eigen::Isometry3d::Identity();
@@ -30,7 +26,7 @@ struct RigidCase {
   const Eigen::Isometry3d motion = some_rigid_motion();
   const PolygonMesh plane = make_plane({.faces = ShapeFaces::Quads, .resolution = 8});
   LimitSurface source_surface{plane};
-  LimitSurface target_surface{moved(plane, motion)};
+  LimitSurface target_surface{test::moved(plane, motion)};
   SurfaceProjector source{source_surface}, target{target_surface};
   Region from, to;
   RigidCase() {

@@ -21,22 +21,11 @@
 #include "elastic/transfer/color_source.h"
 #include "elastic/transfer/painted_surface.h"
 #include "elastic/transfer/target_samples.h"
+#include "rigid_motion.h"
 #include "support.h"
 
 namespace elastic {
 namespace {
-
-Eigen::Isometry3d some_rigid_motion() {
-  Eigen::Isometry3d m = Eigen::Isometry3d::Identity();
-  m.rotate(Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized()));
-  m.pretranslate(Eigen::Vector3d(0.3, -1.2, 2.5));
-  return m;
-}
-
-PolygonMesh moved(PolygonMesh mesh, const Eigen::Isometry3d& motion) {
-  for (Eigen::Vector3d& p : mesh.positions) p = motion * p;
-  return mesh;
-}
 
 // Everything a mapping references, kept alive together.
 struct MappedPair {
@@ -89,7 +78,8 @@ std::unique_ptr<MappedPair> rigid_disk_pair(const PolygonMesh& plane,
   RegionSpec target_spec = source_spec;
   target_spec.center = motion * source_spec.center;
   target_spec.anchor = motion * *source_spec.anchor;
-  return std::make_unique<MappedPair>(plane, source_spec, moved(plane, motion), target_spec, 400);
+  return std::make_unique<MappedPair>(plane, source_spec, test::moved(plane, motion), target_spec,
+                                      400);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -159,7 +149,7 @@ TEST(PaintColorSource, RejectsSourcesWithoutTheData) {
 
 TEST(PaintTransfer, LinearColourArrivesExactlyAtParticlesAndInterpolatedBetween) {
   const PolygonMesh plane = plane_with_linear_colors();
-  const Eigen::Isometry3d motion = some_rigid_motion();
+  const Eigen::Isometry3d motion = test::rigid_motion();
   const auto pair = rigid_disk_pair(plane, motion);
   const ColorSource colors = ColorSource::vertex_colors(*pair->source_surface);
 
@@ -211,7 +201,7 @@ TEST(PaintTransfer, LinearColourArrivesExactlyAtParticlesAndInterpolatedBetween)
 
 TEST(PaintTransfer, RefinementKeepsTheBoundaryOnTheCurveAndConforms) {
   const PolygonMesh plane = make_plane({.resolution = 8});
-  const auto pair = rigid_disk_pair(plane, some_rigid_motion());
+  const auto pair = rigid_disk_pair(plane, test::rigid_motion());
   TargetSamplingOptions options = pair->sampling();
   options.max_edge = 0.04;
   const TargetSamples s = sample_target(*pair->to, pair->mapping(), options);
@@ -234,7 +224,7 @@ TEST(PaintTransfer, RefinementKeepsTheBoundaryOnTheCurveAndConforms) {
   // the cut's curve is the heat-method circle within about 1% of the radius (docs/regions.md);
   // what matters here is that refined boundary vertices stay on the chords' (u,v) lines, i.e. as
   // close to the circle as the coarse ones.
-  const Eigen::Vector3d centre = some_rigid_motion() * Eigen::Vector3d(0.1, 0.05, 0);
+  const Eigen::Vector3d centre = test::rigid_motion() * Eigen::Vector3d(0.1, 0.05, 0);
   double coarse_error = 0.0, fine_error = 0.0;
   for (int v : pair->to->boundary) {
     coarse_error = std::max(coarse_error, std::abs((pair->to->positions[v] - centre).norm() - 0.6));
@@ -380,9 +370,9 @@ struct TexturedPair {
     RegionSpec source_spec = plane.region;
     source_spec.anchor = Eigen::Vector3d(-1, -1, 0);
     RegionSpec target_spec = plane.region;
-    target_spec.anchor = some_rigid_motion() * *source_spec.anchor;
-    pair = std::make_unique<MappedPair>(plane.mesh, source_spec,
-                                        moved(plane.mesh, some_rigid_motion()), target_spec, 400);
+    target_spec.anchor = test::rigid_motion() * *source_spec.anchor;
+    pair = std::make_unique<MappedPair>(
+        plane.mesh, source_spec, test::moved(plane.mesh, test::rigid_motion()), target_spec, 400);
   }
 };
 
@@ -573,7 +563,7 @@ TEST(PaintBake, FeatherRampsFromTheBoundaryAndAlphaScales) {
 
 TEST(PaintPly, ColouredMeshRoundTripsThroughThePlyReader) {
   const PolygonMesh plane = plane_with_linear_colors();
-  const auto pair = rigid_disk_pair(plane, some_rigid_motion());
+  const auto pair = rigid_disk_pair(plane, test::rigid_motion());
   const ColorSource colors = ColorSource::vertex_colors(*pair->source_surface);
   PaintedSurfaceOptions options;
   options.resolution = 4;
@@ -597,7 +587,7 @@ TEST(PaintPly, ColouredMeshRoundTripsThroughThePlyReader) {
   // Region vertices carry the field at their pre-image; the others the target's own colours,
   // which (the target is the moved plane with the same vertex colours) is the field at the
   // pre-image as well: the painted mesh is continuous across the boundary.
-  const Eigen::Isometry3d inverse = some_rigid_motion().inverse();
+  const Eigen::Isometry3d inverse = test::rigid_motion().inverse();
   for (int v = 0; v < mesh.num_vertices(); ++v) {
     EXPECT_LT((mesh.vertex_colors[v] - linear_color(inverse * mesh.positions[v])).norm(), 1e-5f);
   }

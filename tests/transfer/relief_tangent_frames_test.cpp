@@ -13,21 +13,10 @@
 #include "elastic/regions/region_spec.h"
 #include "elastic/shapes/procedural_shapes.h"
 #include "elastic/transfer/tangent_frames.h"
+#include "rigid_motion.h"
 
 namespace elastic {
 namespace {
-
-Eigen::Isometry3d some_rigid_motion() {
-  Eigen::Isometry3d m = Eigen::Isometry3d::Identity();
-  m.rotate(Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized()));
-  m.pretranslate(Eigen::Vector3d(0.3, -1.2, 2.5));
-  return m;
-}
-
-PolygonMesh moved(PolygonMesh mesh, const Eigen::Isometry3d& motion) {
-  for (Eigen::Vector3d& p : mesh.positions) p = motion * p;
-  return mesh;
-}
 
 // Everything a mapped pair of regions needs, kept alive together (projectors reference surfaces,
 // regions and the mapping reference projectors).
@@ -65,7 +54,7 @@ std::unique_ptr<Mapped> rigid_plane_pair(const Eigen::Isometry3d& motion) {
   RegionSpec target_spec = source_spec;
   target_spec.center = motion * source_spec.center;
   target_spec.anchor = motion * *source_spec.anchor;
-  return map_pair(plane, moved(plane, motion), source_spec, target_spec);
+  return map_pair(plane, test::moved(plane, motion), source_spec, target_spec);
 }
 
 // Random source points inside a disk of the xy plane (projected onto the source surface).
@@ -200,7 +189,7 @@ TEST(ReliefFrames, IdentityMapLeavesVectorsUnchanged) {
 // A rigid map rotates vectors by its rotation, in both modes, for tangent and normal vectors
 // alike; frame components are kept.
 TEST(ReliefFrames, RigidMapRotatesVectorsByTheRotation) {
-  const Eigen::Isometry3d motion = some_rigid_motion();
+  const Eigen::Isometry3d motion = test::rigid_motion();
   const auto m = rigid_plane_pair(motion);
   ASSERT_TRUE(m->result.relaxation.converged);
   const Eigen::Matrix3d rotation = motion.linear();
@@ -249,14 +238,14 @@ TEST(ReliefFrames, RigidMapRotatesVectorsByTheRotation) {
 // Mapping::forward's, which interpolates in disk coordinates and lands ~1e-4 away; there the
 // target normal differs by curvature * 1e-4.)
 TEST(ReliefFrames, RigidMapOfACylinderRotatesTangentVectors) {
-  const Eigen::Isometry3d motion = some_rigid_motion();
+  const Eigen::Isometry3d motion = test::rigid_motion();
   const PolygonMesh cylinder = make_cylinder({.resolution = 24});
   RegionSpec source_spec = parse_region_spec("disk:0.5,0,0,0.4");
   source_spec.anchor = Eigen::Vector3d(0.5, 0, 1);
   RegionSpec target_spec = source_spec;
   target_spec.center = motion * source_spec.center;
   target_spec.anchor = motion * *source_spec.anchor;
-  const auto m = map_pair(cylinder, moved(cylinder, motion), source_spec, target_spec);
+  const auto m = map_pair(cylinder, test::moved(cylinder, motion), source_spec, target_spec);
   ASSERT_TRUE(m->result.relaxation.converged);
   const Eigen::Matrix3d rotation = motion.linear();
   // How congruent the relaxed grid is to the source grid. On this curved surface the boundary
@@ -308,7 +297,7 @@ TEST(ReliefFrames, JacobianMatchesFiniteDifferencesOfForward) {
   const PolygonMesh plane = make_plane({.resolution = 8});
   Eigen::Isometry3d tilt = Eigen::Isometry3d::Identity();
   tilt.rotate(Eigen::AngleAxisd(0.5, Eigen::Vector3d::UnitX()));
-  const auto m = map_pair(plane, moved(plane, tilt), parse_region_spec("disk:0,0,0,0.5"),
+  const auto m = map_pair(plane, test::moved(plane, tilt), parse_region_spec("disk:0,0,0,0.5"),
                           parse_region_spec("disk:0,0,0,0.7"), 300);
   const double h = 1e-5;
   std::vector<double> errors;
