@@ -85,9 +85,12 @@ ProgressCallback terminal_progress(bool quiet) {
     constexpr int kWidth = 20;
     std::string bar;
     if (fraction >= 0.0) {
-      const int filled = static_cast<int>(fraction * kWidth + 0.5);
-      bar = "[" + std::string(static_cast<size_t>(filled), '#') +
-            std::string(static_cast<size_t>(kWidth - filled), '.') + "] ";
+      const auto filled =
+          static_cast<size_t>(std::clamp(fraction * kWidth + 0.5, 0.0, 1.0 * kWidth));
+      bar.push_back('[');
+      bar.append(filled, '#');
+      bar.append(static_cast<size_t>(kWidth) - filled, '.');
+      bar.append("] ");
     }
     std::string left;
     if (fraction > 0.05 && in_stage > 0.5) {
