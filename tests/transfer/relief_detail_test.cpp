@@ -13,6 +13,7 @@
 #include "elastic/regions/region_spec.h"
 #include "elastic/shapes/procedural_shapes.h"
 #include "elastic/transfer/geometric_detail.h"
+#include "mapped_pair.h"
 
 namespace elastic {
 namespace {
@@ -41,31 +42,8 @@ PolygonMesh bump_mesh(const Eigen::Vector2d& center, double half, int n, double 
   return mesh;
 }
 
-struct Mapped {
-  std::unique_ptr<LimitSurface> source_surface, target_surface;
-  std::unique_ptr<SurfaceProjector> source, target;
-  Region from, to;
-  MapResult result;
-  std::unique_ptr<MapDifferential> differential;
-};
-
-std::unique_ptr<Mapped> map_pair(const PolygonMesh& source_mesh, const PolygonMesh& target_mesh,
-                                 const RegionSpec& source_spec, const RegionSpec& target_spec,
-                                 int particles) {
-  auto m = std::make_unique<Mapped>();
-  m->source_surface = std::make_unique<LimitSurface>(source_mesh);
-  m->target_surface = std::make_unique<LimitSurface>(target_mesh);
-  m->source = std::make_unique<SurfaceProjector>(*m->source_surface);
-  m->target = std::make_unique<SurfaceProjector>(*m->target_surface);
-  m->from = make_region(*m->source, source_spec);
-  m->to = make_region(*m->target, target_spec);
-  MapOptions options;
-  options.sampling.layout.particles = particles;
-  m->result = map_regions(*m->source, m->from, *m->target, m->to, options);
-  m->differential =
-      std::make_unique<MapDifferential>(*m->source_surface, *m->target_surface, m->result);
-  return m;
-}
+using test::map_pair;
+using test::Mapped;
 
 std::unique_ptr<Mapped> plane_onto_moved_plane(const Eigen::Isometry3d& motion) {
   PolygonMesh plane = make_plane({.faces = ShapeFaces::Quads, .resolution = 12});

@@ -13,38 +13,14 @@
 #include "elastic/regions/region_spec.h"
 #include "elastic/shapes/procedural_shapes.h"
 #include "elastic/transfer/tangent_frames.h"
+#include "mapped_pair.h"
 #include "rigid_motion.h"
 
 namespace elastic {
 namespace {
 
-// Everything a mapped pair of regions needs, kept alive together (projectors reference surfaces,
-// regions and the mapping reference projectors).
-struct Mapped {
-  std::unique_ptr<LimitSurface> source_surface, target_surface;
-  std::unique_ptr<SurfaceProjector> source, target;
-  Region from, to;
-  MapResult result;
-  std::unique_ptr<MapDifferential> differential;
-};
-
-std::unique_ptr<Mapped> map_pair(const PolygonMesh& source_mesh, const PolygonMesh& target_mesh,
-                                 RegionSpec source_spec, RegionSpec target_spec,
-                                 int particles = 400) {
-  auto m = std::make_unique<Mapped>();
-  m->source_surface = std::make_unique<LimitSurface>(source_mesh);
-  m->target_surface = std::make_unique<LimitSurface>(target_mesh);
-  m->source = std::make_unique<SurfaceProjector>(*m->source_surface);
-  m->target = std::make_unique<SurfaceProjector>(*m->target_surface);
-  m->from = make_region(*m->source, source_spec);
-  m->to = make_region(*m->target, target_spec);
-  MapOptions options;
-  options.sampling.layout.particles = particles;
-  m->result = map_regions(*m->source, m->from, *m->target, m->to, options);
-  m->differential =
-      std::make_unique<MapDifferential>(*m->source_surface, *m->target_surface, m->result);
-  return m;
-}
+using test::map_pair;
+using test::Mapped;
 
 // A disk on a plane and the same disk on a rigidly moved copy: the map is the rigid motion.
 std::unique_ptr<Mapped> rigid_plane_pair(const Eigen::Isometry3d& motion) {
