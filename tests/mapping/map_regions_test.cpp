@@ -68,9 +68,9 @@ TEST(MapRegions, PlaneOntoCapConvergesWithoutFolds) {
   }
 }
 
-// Forward then inverse returns near the start (the two directions interpolate the same grid through
-// different disk maps, so they agree to the grid's interpolation error, not to round-off); points
-// outside the region answer "outside".
+// Forward then inverse returns near the start (both directions are the grid's affine map per
+// triangle; they differ only by the magnet's step off the particles' chord planes on the cylinder,
+// see mapping_test.cpp for the bound), and points outside the region answer "outside".
 TEST(MapRegions, MappingAnswersBothWays) {
   const LimitSurface source_surface(make_plane({.resolution = 8}));
   const LimitSurface target_surface(make_cylinder({.resolution = 24}));

@@ -1,44 +1,31 @@
 #include "elastic/mapping/mapping.h"
 
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <string>
+#include <unordered_map>
+#include <utility>
+
 #include "elastic/core/error.h"
 #include "elastic/core/triangle_locator_2d.h"
 
 namespace elastic {
-
-struct Mapping::Impl {
-  const SurfaceProjector* source = nullptr;
-  const SurfaceProjector* target = nullptr;
-  const RegionDiskMap* source_disk = nullptr;
-  const RegionDiskMap* target_disk = nullptr;
-  std::vector<Eigen::Vector3i> triangles;
-  std::vector<SurfacePoint> source_points;
-  std::vector<SurfacePoint> target_points;
-  Eigen::Matrix3Xd source_positions;
-  Eigen::Matrix3Xd target_positions;
-  TriangleLocator2D source_locator;  // grid triangles in source-disk coordinates
-  TriangleLocator2D target_locator;  // grid triangles in target-disk coordinates
-
-  // Barycentric combination of particle positions, put on `surface` by the magnet warm-started from
-  // the triangle's particle with the largest weight.
-  static Location land(const SurfaceProjector& projector, const Eigen::Matrix3Xd& positions,
-                       const std::vector<SurfacePoint>& points, const Eigen::Vector3i& tri,
-                       const Eigen::Vector3d& w, int triangle) {
-    Location out;
-    const Eigen::Vector3d x =
-        w[0] * positions.col(tri[0]) + w[1] * positions.col(tri[1]) + w[2] * positions.col(tri[2]);
-    int heaviest = 0;
-    w.maxCoeff(&heaviest);
-    const ClosestPoint cp = projector.closest(x, points[tri[heaviest]]);
-    out.inside = true;
-    out.point = cp.point;
-    out.position = cp.position;
-    out.triangle = triangle;
-    out.barycentric = w;
-    return out;
-  }
-};
-
 namespace {
+
+// Weights below -kRoundOff are "negative beyond round-off". A weight is a ratio of a distance to a
+// triangle height; for a query exactly on an edge or at a corner it comes out as ~1e-15 of
+// whichever sign, so 1e-10 separates "on the edge" from "across it" with a wide margin while still
+// being far below anything a caller could measure (1e-10 of a grid spacing).
+constexpr double kRoundOff = 1e-10;
+
+// The walk from the disk map's guess crosses at most a few triangles on a well-relaxed grid (the
+// disk location is off by a fraction of a triangle, or by a few triangles where the grid folds in
+// disk coordinates near the boundary); the bound only stops a pathological walk.
+constexpr int kMaxWalkSteps = 64;
+
 // Splits every grid face into a fan of triangles from its first corner (faces are convex in the
 // grid's layout: quads of the regular grid and triangles of the boundary band).
 std::vector<Eigen::Vector3i> grid_triangles(const GridMesh& mesh) {
@@ -53,7 +40,201 @@ std::vector<Eigen::Vector3i> grid_triangles(const GridMesh& mesh) {
   }
   return triangles;
 }
+
+// neighbours[t][k]: the triangle across the edge of t opposite its corner k (the edge
+// tri[k+1] -> tri[k+2]), or -1 on the grid's boundary. Triangles are consistently oriented, so the
+// neighbour holds the same edge reversed.
+std::vector<std::array<int, 3>> triangle_neighbours(const std::vector<Eigen::Vector3i>& triangles,
+                                                    int num_particles) {
+  const auto key = [num_particles](int a, int b) {
+    return static_cast<std::int64_t>(a) * num_particles + b;
+  };
+  std::unordered_map<std::int64_t, int> edge_owner;  // directed edge -> triangle
+  edge_owner.reserve(triangles.size() * 3);
+  for (size_t t = 0; t < triangles.size(); ++t) {
+    const Eigen::Vector3i& tri = triangles[t];
+    for (int k = 0; k < 3; ++k)
+      edge_owner.emplace(key(tri[k], tri[(k + 1) % 3]), static_cast<int>(t));
+  }
+  std::vector<std::array<int, 3>> neighbours(triangles.size(), {-1, -1, -1});
+  for (size_t t = 0; t < triangles.size(); ++t) {
+    const Eigen::Vector3i& tri = triangles[t];
+    for (int k = 0; k < 3; ++k) {
+      const auto it = edge_owner.find(key(tri[(k + 2) % 3], tri[(k + 1) % 3]));
+      if (it != edge_owner.end()) neighbours[t][static_cast<size_t>(k)] = it->second;
+    }
+  }
+  return neighbours;
+}
+
+// Barycentric coordinates of the orthogonal projection of x onto the plane of the triangle
+// (a, b, c): the least-squares solution of min |b1 e1 + b2 e2 - (x - a)| with e1 = b - a,
+// e2 = c - a, from its 2x2 normal equations. False for a (numerically) degenerate triangle.
+bool plane_weights(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c,
+                   const Eigen::Vector3d& x, Eigen::Vector3d& w) {
+  const Eigen::Vector3d e1 = b - a, e2 = c - a, d = x - a;
+  const double g11 = e1.dot(e1), g12 = e1.dot(e2), g22 = e2.dot(e2);
+  const double det = g11 * g22 - g12 * g12;  // |e1 x e2|^2
+  // Relative to g11 g22 this is sin^2 of the triangle's angle at a: 1e-24 means an angle of 1e-12.
+  if (!(det > 1e-24 * g11 * g22)) return false;
+  const double r1 = e1.dot(d), r2 = e2.dot(d);
+  const double b1 = (g22 * r1 - g12 * r2) / det, b2 = (g11 * r2 - g12 * r1) / det;
+  w = Eigen::Vector3d(1.0 - b1 - b2, b1, b2);
+  return true;
+}
+
+// The point of the triangle nearest to the point with plane weights w (which may be outside it),
+// as weights: unchanged when inside; otherwise the nearest point of the three edges. Because the
+// point is already in the triangle's plane, this is also the triangle's closest point to the 3D
+// query, and on an edge shared with a neighbour both triangles clamp to the same point.
+Eigen::Vector3d clamp_to_triangle(const std::array<Eigen::Vector3d, 3>& corners,
+                                  const Eigen::Vector3d& w) {
+  if (w.minCoeff() >= 0.0) return w;
+  const Eigen::Vector3d p = w[0] * corners[0] + w[1] * corners[1] + w[2] * corners[2];
+  Eigen::Vector3d best = Eigen::Vector3d::Zero();
+  double best_distance = std::numeric_limits<double>::infinity();
+  for (int k = 0; k < 3; ++k) {
+    const int i = (k + 1) % 3, j = (k + 2) % 3;
+    const Eigen::Vector3d edge = corners[static_cast<size_t>(j)] - corners[static_cast<size_t>(i)];
+    const double length2 = edge.squaredNorm();
+    const double s =
+        length2 > 0.0
+            ? std::clamp((p - corners[static_cast<size_t>(i)]).dot(edge) / length2, 0.0, 1.0)
+            : 0.0;
+    const double distance = (corners[static_cast<size_t>(i)] + s * edge - p).squaredNorm();
+    if (distance < best_distance) {
+      best_distance = distance;
+      best = Eigen::Vector3d::Zero();
+      best[i] = 1.0 - s;
+      best[j] = s;
+    }
+  }
+  return best;
+}
+
 }  // namespace
+
+struct Mapping::Impl {
+  const SurfaceProjector* source = nullptr;
+  const SurfaceProjector* target = nullptr;
+  const RegionDiskMap* source_disk = nullptr;
+  const RegionDiskMap* target_disk = nullptr;
+  std::vector<Eigen::Vector3i> triangles;
+  std::vector<std::array<int, 3>> neighbours;  // see triangle_neighbours()
+  std::vector<SurfacePoint> source_points;
+  std::vector<SurfacePoint> target_points;
+  Eigen::Matrix3Xd source_positions;
+  Eigen::Matrix3Xd target_positions;
+  TriangleLocator2D source_locator;  // grid triangles in source-disk coordinates
+  TriangleLocator2D target_locator;  // grid triangles in target-disk coordinates
+
+  // Where a query lies in the grid: triangle and 3D affine weights, or triangle -1 (outside).
+  struct Found {
+    int triangle = -1;
+    Eigen::Vector3d weights = Eigen::Vector3d::Zero();
+  };
+
+  std::array<Eigen::Vector3d, 3> corners(const Eigen::Matrix3Xd& positions, int t) const {
+    const Eigen::Vector3i& tri = triangles[static_cast<size_t>(t)];
+    return {positions.col(tri[0]), positions.col(tri[1]), positions.col(tri[2])};
+  }
+
+  // Locates the query (3D position x, disk coordinates `disk`) among the grid triangles laid out
+  // by `positions` (the query side's particles): the disk locator's triangle (or, when the disk
+  // point is in no grid triangle, its nearest one) is the first guess; then a walk in 3D from
+  // triangle to triangle across the edge opposite the most negative plane weight, until the
+  // weights are all >= -kRoundOff. See the file comment of mapping.h for the outcomes.
+  Found locate(const TriangleLocator2D& locator, const Eigen::Matrix3Xd& positions,
+               const Eigen::Vector2d& disk, const Eigen::Vector3d& x) const {
+    TriangleLocator2D::Hit guess = locator.locate(disk, 1e-9);
+    const bool disk_inside = guess.found();
+    if (!disk_inside) guess = locator.nearest(disk);
+    if (!guess.found()) return {};
+
+    int t = guess.triangle;
+    Eigen::Vector3d w;
+    {
+      const auto c = corners(positions, t);
+      if (!plane_weights(c[0], c[1], c[2], x, w)) {
+        // A grid triangle degenerate in 3D has no plane to project on: keep the disk's answer
+        // there (inside only if the disk map put the query in it).
+        return disk_inside ? Found{t, guess.barycentric} : Found{};
+      }
+    }
+    std::array<int, kMaxWalkSteps> visited{};
+    int num_visited = 0;
+    int best = t;  // the visited triangle whose weights are the least negative
+    Eigen::Vector3d best_weights = w;
+    while (true) {
+      visited[static_cast<size_t>(num_visited++)] = t;
+      if (w.minCoeff() > best_weights.minCoeff()) {
+        best = t;
+        best_weights = w;
+      }
+      if (w.minCoeff() >= -kRoundOff) return {t, w};
+
+      // Cross the edge opposite the most negative weight; if that edge is on the grid's boundary
+      // (or leads back to a visited triangle), the next most negative one, which lets the walk
+      // turn around a concave stretch of the boundary.
+      std::array<int, 3> order{0, 1, 2};
+      std::sort(order.begin(), order.end(), [&w](int i, int j) { return w[i] < w[j]; });
+      int next = -1;
+      bool at_boundary = false;
+      Eigen::Vector3d next_weights;
+      for (const int k : order) {
+        if (w[k] >= -kRoundOff) break;
+        const int n = neighbours[static_cast<size_t>(t)][static_cast<size_t>(k)];
+        if (n < 0) {
+          at_boundary = true;
+          continue;
+        }
+        if (std::find(visited.begin(), visited.begin() + num_visited, n) !=
+            visited.begin() + num_visited)
+          continue;
+        const auto c = corners(positions, n);
+        if (!plane_weights(c[0], c[1], c[2], x, next_weights)) continue;
+        next = n;
+        break;
+      }
+      if (next >= 0 && num_visited < kMaxWalkSteps) {
+        t = next;
+        w = next_weights;
+        continue;
+      }
+      if (at_boundary && next < 0) {
+        // The query is beyond the grid's boundary in 3D. Outside if the disk maps agree; if the
+        // disk maps put it inside the grid (the two disagree by the disk maps' non-affinity, a
+        // sliver along the boundary), it is clamped onto this boundary triangle.
+        if (!disk_inside) return {};
+        return {t, clamp_to_triangle(corners(positions, t), w)};
+      }
+      // Cycling between triangles whose planes leave a gap (a query over an edge where the grid
+      // bends) or out of steps: the least-outside triangle, clamped; across a shared edge both
+      // sides clamp to the same point of the edge, so this is continuous.
+      return {best, clamp_to_triangle(corners(positions, best), best_weights)};
+    }
+  }
+
+  // Barycentric combination of particle positions, put on `surface` by the magnet warm-started from
+  // the triangle's particle with the largest weight.
+  Location land(const SurfaceProjector& projector, const Eigen::Matrix3Xd& positions,
+                const std::vector<SurfacePoint>& points, const Found& found) const {
+    const Eigen::Vector3i& tri = triangles[static_cast<size_t>(found.triangle)];
+    const Eigen::Vector3d& w = found.weights;
+    const Eigen::Vector3d x =
+        w[0] * positions.col(tri[0]) + w[1] * positions.col(tri[1]) + w[2] * positions.col(tri[2]);
+    int heaviest = 0;
+    w.maxCoeff(&heaviest);
+    const ClosestPoint cp = projector.closest(x, points[static_cast<size_t>(tri[heaviest])]);
+    Location out;
+    out.inside = true;
+    out.point = cp.point;
+    out.position = cp.position;
+    out.triangle = found.triangle;
+    out.barycentric = w;
+    return out;
+  }
+};
 
 Mapping::Mapping(const ParticleGrid& grid, const SurfaceProjector& source,
                  const RegionDiskMap& source_disk, const SurfaceProjector& target,
@@ -68,19 +249,21 @@ Mapping::Mapping(const ParticleGrid& grid, const SurfaceProjector& source,
   impl->source_disk = &source_disk;
   impl->target_disk = &target_disk;
   impl->triangles = grid_triangles(grid.mesh);
+  impl->neighbours = triangle_neighbours(impl->triangles, n);
   impl->source_points = grid.source_points;
   impl->target_points = target_points;
   impl->source_positions.resize(3, n);
   impl->target_positions.resize(3, n);
-  std::vector<Eigen::Vector2d> source_uv(n), target_uv(n);
+  std::vector<Eigen::Vector2d> source_uv(static_cast<size_t>(n)), target_uv(static_cast<size_t>(n));
   for (int i = 0; i < n; ++i) {
-    impl->source_positions.col(i) = source.surface().position(grid.source_points[i]);
-    impl->target_positions.col(i) = target.surface().position(target_points[i]);
-    if (!source_disk.to_disk(grid.source_points[i], source_uv[i])) {
+    const auto u = static_cast<size_t>(i);
+    impl->source_positions.col(i) = source.surface().position(grid.source_points[u]);
+    impl->target_positions.col(i) = target.surface().position(target_points[u]);
+    if (!source_disk.to_disk(grid.source_points[u], source_uv[u])) {
       throw NumericalError("mapping",
                            "particle " + std::to_string(i) + " is outside the source region");
     }
-    if (!target_disk.to_disk(target_points[i], target_uv[i])) {
+    if (!target_disk.to_disk(target_points[u], target_uv[u])) {
       throw NumericalError("mapping",
                            "particle " + std::to_string(i) + " is outside the target region");
     }
@@ -93,19 +276,19 @@ Mapping::Mapping(const ParticleGrid& grid, const SurfaceProjector& source,
 Mapping::Location Mapping::forward(const SurfacePoint& source_point) const {
   Eigen::Vector2d disk;
   if (!impl_ || !impl_->source_disk->to_disk(source_point, disk)) return {};
-  const auto hit = impl_->source_locator.locate(disk, 1e-9);
-  if (!hit.found()) return {};
-  return Impl::land(*impl_->target, impl_->target_positions, impl_->target_points,
-                    impl_->triangles[hit.triangle], hit.barycentric, hit.triangle);
+  const Impl::Found found = impl_->locate(impl_->source_locator, impl_->source_positions, disk,
+                                          impl_->source->surface().position(source_point));
+  if (found.triangle < 0) return {};
+  return impl_->land(*impl_->target, impl_->target_positions, impl_->target_points, found);
 }
 
 Mapping::Location Mapping::inverse(const SurfacePoint& target_point) const {
   Eigen::Vector2d disk;
   if (!impl_ || !impl_->target_disk->to_disk(target_point, disk)) return {};
-  const auto hit = impl_->target_locator.locate(disk, 1e-9);
-  if (!hit.found()) return {};
-  return Impl::land(*impl_->source, impl_->source_positions, impl_->source_points,
-                    impl_->triangles[hit.triangle], hit.barycentric, hit.triangle);
+  const Impl::Found found = impl_->locate(impl_->target_locator, impl_->target_positions, disk,
+                                          impl_->target->surface().position(target_point));
+  if (found.triangle < 0) return {};
+  return impl_->land(*impl_->source, impl_->source_positions, impl_->source_points, found);
 }
 
 const std::vector<Eigen::Vector3i>& Mapping::triangles() const {

@@ -2,14 +2,37 @@
 /// \file
 /// `Mapping`: the result of mapping a source region onto a target region, queryable both ways.
 ///
-/// The relaxed particle grid defines a piecewise-linear correspondence: each grid face (quads split
-/// into triangles) spans a triangle of source particles and the same triangle of target particles.
-/// A query is located in the grid through the regions' disk maps (mapping/initial_map.h): a source
-/// point goes to the source disk, is located among the grid triangles laid out by their particles'
-/// source-disk coordinates, and its barycentric coordinates there are applied to the target
-/// particles; the result is put on the target surface by the magnet. The inverse does the same with
-/// target-disk coordinates of the relaxed particles. Points outside the region (or outside the
-/// grid, which covers the region up to the boundary curve) answer "outside", never a guess.
+/// The correspondence is the relaxed particle grid's piecewise-linear map in 3D, composed with the
+/// magnet. Each grid face (quads split into triangles, see triangles()) spans a triangle of source
+/// particles and the same triangle of target particles, and the map is exactly the affine map
+/// between the two triangles: a query x on the source is projected orthogonally onto the plane of
+/// its source particle triangle, its barycentric weights there are applied to the target particles,
+/// and the resulting point is put on the target surface by the magnet (closest point, warm-started
+/// at the triangle's heaviest particle). The inverse is the same with the roles swapped. So a
+/// particle maps exactly onto its partner, a map that is rigid at the particles between flat
+/// regions is rigid everywhere, and a field linear on a flat source arrives linearly interpolated.
+/// Particle positions are the limit positions of their surface points.
+///
+/// Locating the triangle: the regions' disk maps (mapping/initial_map.h) give a cheap, robust first
+/// guess (the grid triangle containing the query's disk coordinates among the particles' disk
+/// coordinates, or the nearest one when none does). Disk maps are not affine on a grid triangle, so
+/// the guess can be a neighbour; from it the query walks in 3D: plane weights in the current
+/// triangle; if one is negative beyond round-off (1e-10), step across the edge opposite the most
+/// negative weight (or, when that edge is the grid's boundary, the next negative one), up to 64
+/// steps, never revisiting a triangle. Outcomes:
+/// - all weights >= -1e-10: the answer, with those (unclamped) weights;
+/// - the walk would leave the grid across its boundary: the query is *outside* when its disk
+///   coordinates were outside the grid too; when the disk map had it inside (a sliver along the
+///   boundary where the disk maps and the 3D chords disagree) it is clamped onto that boundary
+///   triangle: the weights of the triangle's point nearest the query (>= 0);
+/// - the walk cycles (a query above an edge where the grid bends, between two planes that leave a
+///   gap) or runs out of steps: the visited triangle with the least negative weight, clamped (both
+///   sides of a shared edge clamp to the same point of it, so this is continuous).
+/// "Outside" therefore means: outside the region (no disk coordinates), or outside the grid (whose
+/// boundary particles lie on the boundary curve, joined by chords) both in 3D and in the disk map.
+/// Never a guess. Location::triangle and Location::barycentric report the final triangle and 3D
+/// weights. A grid triangle that is degenerate in 3D on the query's side keeps the disk map's
+/// weights.
 ///
 /// A Mapping references the two projectors and regions it was built from; they must outlive it.
 /// Queries are const and thread-safe.
@@ -31,9 +54,10 @@ class Mapping {
     bool inside = false;                                 ///< false: the query is outside the region
     SurfacePoint point;                                  ///< on the other surface (when inside)
     Eigen::Vector3d position = Eigen::Vector3d::Zero();  ///< its limit position
-    int triangle = -1;                                   ///< grid triangle (index into triangles())
-    Eigen::Vector3d barycentric =
-        Eigen::Vector3d::Zero();  ///< weights of that triangle's particles
+    int triangle = -1;  ///< grid triangle (index into triangles()) the query was located in
+    /// Weights of that triangle's particles: the query's affine (plane-projected) coordinates in
+    /// the query side's particle triangle, applied unchanged to the other side's particles.
+    Eigen::Vector3d barycentric = Eigen::Vector3d::Zero();
   };
 
   Mapping() = default;
