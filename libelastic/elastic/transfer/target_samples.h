@@ -35,16 +35,19 @@
 ///    of that triangle), an error of at most half an edge. Both are counted in `nudged`.
 /// What still has no source keeps `inside = false` and is counted in `unresolved`.
 ///
-/// Piecewise-linear in 3D: Mapping::inverse takes its weights in the grid triangle from the disk
-/// maps' coordinates, which are not affine over a grid triangle, so between particles it deviates
-/// from the particles' piecewise-linear map by O(h^2) times the disk maps' second derivatives (up
-/// to a few percent of the spacing near the corners of a rectangle). When the particles' positions
-/// are given, the weights are recomputed as the barycentric coordinates of the vertex's projection
-/// onto the plane of the target particle triangle the inverse located (extrapolating slightly when
-/// the disk maps located a neighbour), applied to the source particles, and the resulting point is
-/// put on the source surface by Gauss-Newton steps from the inverse's answer (closest point). Then
-/// a map that is rigid at the particles between flat regions is rigid everywhere, and a colour
-/// field linear on a flat source arrives linearly interpolated between particles.
+/// Piecewise-linear in 3D: Mapping::inverse is itself the particles' piecewise-linear map in 3D
+/// (affine on each grid triangle, see mapping.h). When the particles' positions are given, the
+/// weights are recomputed from them as the barycentric coordinates of the vertex's projection onto
+/// the plane of the target particle triangle the inverse located, applied to the source particles,
+/// and the resulting point is put on the source surface by Gauss-Newton steps from the inverse's
+/// answer (closest point). For a vertex the inverse answered directly this reproduces the
+/// inverse's own weights (with the given positions: grid.source_positions() has boundary particles
+/// on the region's chord polyline where the Mapping uses their limit positions); what it adds is
+/// extrapolation: for interior vertices that took an adjacent covered vertex's triangle, and for
+/// vertices the inverse clamped onto a boundary triangle, the triangle's affine map is extended a
+/// little past the grid's edge. Then a map that is rigid at the particles between flat regions is
+/// rigid everywhere, and a colour field linear on a flat source arrives linearly interpolated
+/// between particles.
 ///
 /// The refinement and the inverse queries run in parallel (TBB); the result does not depend on the
 /// number of threads.
