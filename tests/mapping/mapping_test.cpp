@@ -200,7 +200,8 @@ TEST_F(MappingTest, RoundTripIsExactUpToTheCapsSagitta) {
 
 // "Outside" means outside the region: points of the plane beyond the disk answer outside both
 // ways. Just inside a boundary edge of the grid (1e-6 of its length, in its plane) is inside in 3D,
-// whatever the disk maps say there, and is answered from that boundary triangle.
+// whatever the disk maps say there, and is answered from that boundary triangle; just outside it
+// is outside, or clamped onto the edge where the disk map has it inside.
 TEST_F(MappingTest, OutsideTheRegionIsOutsideAndTheGridEdgeIsInside) {
   for (int k = 0; k < 16; ++k) {
     const double a = 0.39269908169872414 * k, r = 0.7 + 0.02 * k;
@@ -218,7 +219,7 @@ TEST_F(MappingTest, OutsideTheRegionIsOutsideAndTheGridEdgeIsInside) {
   for (const Eigen::Vector3i& t : triangles) {
     for (int k = 0; k < 3; ++k) directed.emplace(t[k], t[(k + 1) % 3]);
   }
-  int checked = 0;
+  int checked = 0, outside = 0, clamped = 0;
   for (size_t t = 0; t < triangles.size(); ++t) {
     const Eigen::Vector3i& tri = triangles[t];
     for (int k = 0; k < 3; ++k) {
@@ -233,9 +234,28 @@ TEST_F(MappingTest, OutsideTheRegionIsOutsideAndTheGridEdgeIsInside) {
       EXPECT_EQ(loc.triangle, static_cast<int>(t));
       EXPECT_GE(loc.barycentric.minCoeff(), -1e-9);
       ++checked;
+
+      // Just outside the same edge (in the sliver between the chord and the boundary curve, or
+      // outside the region where the two coincide): outside, or, where the disk map puts it inside
+      // the grid, clamped onto this edge: weight 0 opposite it, 1/2 at its ends (up to the 1e-6
+      // offset's component along the edge, which is 0 here).
+      const Eigen::Vector3d y = 0.5 * (source.col(a) + source.col(b)) - 1e-6 * left;
+      const Mapping::Location out = result.mapping.forward(pair_->plane.closest(y).point);
+      if (!out.inside) {
+        ++outside;
+        continue;
+      }
+      ++clamped;
+      EXPECT_EQ(out.triangle, static_cast<int>(t)) << "edge " << a << "-" << b;
+      EXPECT_EQ(out.barycentric[(k + 2) % 3], 0.0) << "edge " << a << "-" << b;
+      EXPECT_NEAR(out.barycentric[k], 0.5, 1e-9) << "edge " << a << "-" << b;
+      EXPECT_NEAR(out.barycentric[(k + 1) % 3], 0.5, 1e-9) << "edge " << a << "-" << b;
     }
   }
   EXPECT_GT(checked, 20);
+  EXPECT_EQ(outside + clamped, checked);
+  RecordProperty("outside_beyond_edge", outside);
+  RecordProperty("clamped_beyond_edge", clamped);
 }
 
 }  // namespace

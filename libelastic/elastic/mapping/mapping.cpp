@@ -21,9 +21,9 @@ namespace {
 // being far below anything a caller could measure (1e-10 of a grid spacing).
 constexpr double kRoundOff = 1e-10;
 
-// The walk from the disk map's guess crosses at most a few triangles on a well-relaxed grid (the
-// disk location is off by a fraction of a triangle, or by a few triangles where the grid folds in
-// disk coordinates near the boundary); the bound only stops a pathological walk.
+// The walk from the disk map's guess crosses one or two triangles on a well-relaxed grid (the disk
+// location is off by a fraction of a triangle); the bound only stops a pathological walk (a grid
+// folded in 3D or in disk coordinates).
 constexpr int kMaxWalkSteps = 64;
 
 // Splits every grid face into a fan of triangles from its first corner (faces are convex in the
@@ -165,6 +165,7 @@ struct Mapping::Impl {
     int num_visited = 0;
     int best = t;  // the visited triangle whose weights are the least negative
     Eigen::Vector3d best_weights = w;
+    bool met_boundary = false;  // a weight was negative opposite an edge of the grid's boundary
     while (true) {
       visited[static_cast<size_t>(num_visited++)] = t;
       if (w.minCoeff() > best_weights.minCoeff()) {
@@ -179,13 +180,12 @@ struct Mapping::Impl {
       std::array<int, 3> order{0, 1, 2};
       std::sort(order.begin(), order.end(), [&w](int i, int j) { return w[i] < w[j]; });
       int next = -1;
-      bool at_boundary = false;
       Eigen::Vector3d next_weights;
       for (const int k : order) {
         if (w[k] >= -kRoundOff) break;
         const int n = neighbours[static_cast<size_t>(t)][static_cast<size_t>(k)];
         if (n < 0) {
-          at_boundary = true;
+          met_boundary = true;
           continue;
         }
         if (std::find(visited.begin(), visited.begin() + num_visited, n) !=
@@ -196,23 +196,18 @@ struct Mapping::Impl {
         next = n;
         break;
       }
-      if (next >= 0 && num_visited < kMaxWalkSteps) {
-        t = next;
-        w = next_weights;
-        continue;
-      }
-      if (at_boundary && next < 0) {
-        // The query is beyond the grid's boundary in 3D. Outside if the disk maps agree; if the
-        // disk maps put it inside the grid (the two disagree by the disk maps' non-affinity, a
-        // sliver along the boundary), it is clamped onto this boundary triangle.
-        if (!disk_inside) return {};
-        return {t, clamp_to_triangle(corners(positions, t), w)};
-      }
-      // Cycling between triangles whose planes leave a gap (a query over an edge where the grid
-      // bends) or out of steps: the least-outside triangle, clamped; across a shared edge both
-      // sides clamp to the same point of the edge, so this is continuous.
-      return {best, clamp_to_triangle(corners(positions, best), best_weights)};
+      if (next < 0 || num_visited == kMaxWalkSteps) break;
+      t = next;
+      w = next_weights;
     }
+    // No triangle holds the query's projection. Beyond the grid's boundary in 3D: outside if the
+    // disk maps agree; if they put it inside the grid (the two disagree by the disk maps'
+    // non-affinity, a sliver along the boundary), clamped. Otherwise the walk cycled between
+    // triangles whose planes leave a gap (a query above an edge where the grid bends) or ran out
+    // of steps: clamped too. Clamping is onto the least-outside triangle visited; across an edge
+    // shared by two triangles both clamp to the same point of it, so this is continuous.
+    if (met_boundary && !disk_inside) return {};
+    return {best, clamp_to_triangle(corners(positions, best), best_weights)};
   }
 
   // Barycentric combination of particle positions, put on `surface` by the magnet warm-started from

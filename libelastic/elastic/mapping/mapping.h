@@ -21,13 +21,14 @@
 /// negative weight (or, when that edge is the grid's boundary, the next negative one), up to 64
 /// steps, never revisiting a triangle. Outcomes:
 /// - all weights >= -1e-10: the answer, with those (unclamped) weights;
-/// - the walk would leave the grid across its boundary: the query is *outside* when its disk
-///   coordinates were outside the grid too; when the disk map had it inside (a sliver along the
-///   boundary where the disk maps and the 3D chords disagree) it is clamped onto that boundary
-///   triangle: the weights of the triangle's point nearest the query (>= 0);
-/// - the walk cycles (a query above an edge where the grid bends, between two planes that leave a
-///   gap) or runs out of steps: the visited triangle with the least negative weight, clamped (both
-///   sides of a shared edge clamp to the same point of it, so this is continuous).
+/// - otherwise (no triangle holds the query's projection): if the walk met the grid's boundary (a
+///   negative weight opposite a boundary edge) and the query's disk coordinates were outside the
+///   grid too, the query is *outside*. Else it is clamped: the weights of the nearest point of the
+///   least-outside triangle visited (all >= 0). This covers a query beyond the grid's boundary in
+///   3D that the disk map puts inside (a sliver along the boundary where the disk maps and the 3D
+///   chords disagree), a walk cycling between triangles whose planes leave a gap (a query above an
+///   edge where the grid bends; both sides of the edge clamp to the same point of it, so this is
+///   continuous), and a walk out of steps.
 /// "Outside" therefore means: outside the region (no disk coordinates), or outside the grid (whose
 /// boundary particles lie on the boundary curve, joined by chords) both in 3D and in the disk map.
 /// Never a guess. Location::triangle and Location::barycentric report the final triangle and 3D
