@@ -52,12 +52,13 @@ class Mapping {
  public:
   /// Where a query lands.
   struct Location {
-    bool inside = false;                                 ///< false: the query is outside the region
-    SurfacePoint point;                                  ///< on the other surface (when inside)
+    bool inside = false;  ///< false: the query is outside (see the file comment)
+    SurfacePoint point;   ///< on the other surface (when inside)
     Eigen::Vector3d position = Eigen::Vector3d::Zero();  ///< its limit position
     int triangle = -1;  ///< grid triangle (index into triangles()) the query was located in
     /// Weights of that triangle's particles: the query's affine (plane-projected) coordinates in
-    /// the query side's particle triangle, applied unchanged to the other side's particles.
+    /// the query side's particle triangle (clamped when the query was, see the file comment),
+    /// applied unchanged to the other side's particles.
     Eigen::Vector3d barycentric = Eigen::Vector3d::Zero();
   };
 
