@@ -72,7 +72,28 @@ void expect_boundary_untouched(const ParticleGrid& grid, const RelaxationProblem
   EXPECT_EQ(result.boundary_residual, 0.0);
 }
 
-class RigidMotion : public ::testing::TestWithParam<SolverKind> {};
+// The solvers under test: fast mode with either preconditioner (the small test grids would get the
+// direct one by default), and the faithful integrator.
+struct Mode {
+  SolverKind solver = SolverKind::Fast;
+  Preconditioner preconditioner = Preconditioner::Direct;
+  void apply(RelaxationOptions& options) const {
+    options.solver = solver;
+    options.lbfgs.preconditioner = preconditioner;
+    // Coarsen down to a few dozen unknowns so that the small test grids get a real hierarchy.
+    options.lbfgs.multigrid.coarsest_size = 20;
+  }
+};
+const auto kModes = ::testing::Values(Mode{SolverKind::Fast, Preconditioner::Direct},
+                                      Mode{SolverKind::Fast, Preconditioner::Multigrid},
+                                      Mode{SolverKind::Faithful, Preconditioner::Direct});
+std::string mode_name(const ::testing::TestParamInfo<Mode>& info) {
+  return info.param.solver == SolverKind::Faithful
+             ? std::string("faithful")
+             : "fast_" + std::string(to_string(info.param.preconditioner));
+}
+
+class RigidMotion : public ::testing::TestWithParam<Mode> {};
 
 TEST_P(RigidMotion, PlanarGridOntoMovedPlaneIsTheRigidMotion) {
   // An 8 x 8-cell grid of size 1 mapped onto a plane rotated about (1,2,3) by 0.7 rad and
@@ -89,7 +110,7 @@ TEST_P(RigidMotion, PlanarGridOntoMovedPlaneIsTheRigidMotion) {
       make_problem(grid, target, motion * perturb_interior(grid, source, 0.3 * 0.125, 5));
 
   RelaxationOptions options;
-  options.solver = GetParam();
+  GetParam().apply(options);
   // Tight tolerances: the position error is about |P g| / lambda_min(Hessian) (lambda_min ~ 0.3
   // here), so |P g| must fall far below the 1e-8 required of the positions.
   options.relative_gradient_tolerance = 1e-12;
@@ -103,16 +124,15 @@ TEST_P(RigidMotion, PlanarGridOntoMovedPlaneIsTheRigidMotion) {
   EXPECT_LT(result.length_energy + result.angular_energy, 1e-16);
   EXPECT_EQ(result.folded_faces, 0);
   expect_boundary_untouched(grid, problem, result);
-  EXPECT_EQ(result.solver, GetParam());
+  EXPECT_EQ(result.solver, GetParam().solver);
+  if (GetParam().solver == SolverKind::Fast) {
+    EXPECT_EQ(result.preconditioner, GetParam().preconditioner);
+  }
   EXPECT_GT(result.iterations, 0);
   EXPECT_LE(result.relative_gradient, 1e-12);
 }
 
-INSTANTIATE_TEST_SUITE_P(BothSolvers, RigidMotion,
-                         ::testing::Values(SolverKind::Fast, SolverKind::Faithful),
-                         [](const auto& param_info) {
-                           return std::string(to_string(param_info.param));
-                         });
+INSTANTIATE_TEST_SUITE_P(BothSolvers, RigidMotion, kModes, mode_name);
 
 // The cylinder test: a 1.6 x 1.2 rectangle rolled isometrically around the limit surface of a
 // 48-segment cylinder control mesh of radius 1. That limit surface is exactly a generalised
@@ -169,7 +189,7 @@ double rms_length_distortion(const ParticleGrid& grid, const RelaxationResult& r
   return std::sqrt(result.length_energy / sum);
 }
 
-class Cylinder : public ::testing::TestWithParam<SolverKind> {};
+class Cylinder : public ::testing::TestWithParam<Mode> {};
 
 TEST_P(Cylinder, IsometricBoundaryGivesNearZeroLengthDistortion) {
   static const CylinderProblem cylinder;
@@ -182,7 +202,7 @@ TEST_P(Cylinder, IsometricBoundaryGivesNearZeroLengthDistortion) {
   ASSERT_TRUE((problem.boundary_targets.array() == exact.boundary_targets.array()).all());
 
   RelaxationOptions options;
-  options.solver = GetParam();
+  GetParam().apply(options);
   const RelaxationResult result = relax(problem, options);
   EXPECT_TRUE(result.converged) << to_string(result.reason);
   EXPECT_LE(result.relative_gradient, 1e-6);
@@ -204,11 +224,7 @@ TEST_P(Cylinder, IsometricBoundaryGivesNearZeroLengthDistortion) {
   EXPECT_LT((result.positions - exact.initial_positions).colwise().norm().maxCoeff(), 1e-5);
 }
 
-INSTANTIATE_TEST_SUITE_P(BothSolvers, Cylinder,
-                         ::testing::Values(SolverKind::Fast, SolverKind::Faithful),
-                         [](const auto& param_info) {
-                           return std::string(to_string(param_info.param));
-                         });
+INSTANTIATE_TEST_SUITE_P(BothSolvers, Cylinder, kModes, mode_name);
 
 TEST(Relaxation, SameInputsGiveTheSameBitsForAnyThreadCount) {
   const ParticleGrid grid = test::make_quad_grid(12, 10, 0.1, {-0.6, -0.5});
@@ -216,18 +232,23 @@ TEST(Relaxation, SameInputsGiveTheSameBitsForAnyThreadCount) {
   const Target target(test::make_plane_mesh(4, 1.0, motion));
   const RelaxationProblem problem = make_problem(
       grid, target, motion * perturb_interior(grid, test::grid_positions(grid), 0.03, 3));
-  RelaxationOptions options;
-  options.threads = 2;
-  const RelaxationResult a = relax(problem, options);
-  const RelaxationResult b = relax(problem, options);
-  options.threads = 1;
-  const RelaxationResult c = relax(problem, options);
-  EXPECT_TRUE(a.converged);
-  EXPECT_TRUE((a.positions.array() == b.positions.array()).all());
-  EXPECT_TRUE((a.positions.array() == c.positions.array()).all());
-  EXPECT_EQ(a.points, c.points);
-  EXPECT_EQ(a.iterations, c.iterations);
-  EXPECT_EQ(a.length_energy, c.length_energy);
+  for (const Preconditioner preconditioner : {Preconditioner::Direct, Preconditioner::Multigrid}) {
+    RelaxationOptions options;
+    options.lbfgs.preconditioner = preconditioner;
+    options.lbfgs.multigrid.coarsest_size = 20;
+    options.threads = 2;
+    const RelaxationResult a = relax(problem, options);
+    const RelaxationResult b = relax(problem, options);
+    options.threads = 1;
+    const RelaxationResult c = relax(problem, options);
+    EXPECT_TRUE(a.converged);
+    EXPECT_EQ(a.preconditioner, preconditioner);
+    EXPECT_TRUE((a.positions.array() == b.positions.array()).all());
+    EXPECT_TRUE((a.positions.array() == c.positions.array()).all());
+    EXPECT_EQ(a.points, c.points);
+    EXPECT_EQ(a.iterations, c.iterations);
+    EXPECT_EQ(a.length_energy, c.length_energy);
+  }
 }
 
 TEST(Relaxation, NeverFoldsWhenTheMinimumWouldFold) {

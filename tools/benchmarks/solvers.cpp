@@ -65,9 +65,10 @@ const PlaneToCap& plane_to_cap(long particles) {
   return *entry;
 }
 
-void BM_PlaneToCapFast(benchmark::State& state) {
+void run_plane_to_cap(benchmark::State& state, Preconditioner preconditioner) {
   const PlaneToCap& setup = plane_to_cap(state.range(0));
   RelaxationOptions options;  // fast mode, relative tangential gradient 1e-6
+  options.lbfgs.preconditioner = preconditioner;
   RelaxationResult result;
   for (auto _ : state) {
     result = relax(setup.problem, options);
@@ -82,12 +83,39 @@ void BM_PlaneToCapFast(benchmark::State& state) {
   state.counters["setup_ms"] = 1e3 * result.setup_seconds;
   state.counters["solve_ms"] = 1e3 * result.solve_seconds;
   state.counters["held"] = static_cast<double>(result.held_particles.size());
+  state.counters["multigrid"] = result.preconditioner == Preconditioner::Multigrid ? 1.0 : 0.0;
+}
+
+// The default (Preconditioner::Auto: direct up to 30,000 interior particles, multigrid above).
+void BM_PlaneToCapFast(benchmark::State& state) { run_plane_to_cap(state, Preconditioner::Auto); }
+// Either preconditioner at every size, to see where they cross (LbfgsOptions::direct_limit).
+void BM_PlaneToCapDirect(benchmark::State& state) {
+  run_plane_to_cap(state, Preconditioner::Direct);
+}
+void BM_PlaneToCapMultigrid(benchmark::State& state) {
+  run_plane_to_cap(state, Preconditioner::Multigrid);
 }
 BENCHMARK(BM_PlaneToCapFast)
     ->Name("PlaneToCap")
     ->Arg(409)
     ->Arg(2000)
     ->Arg(5775)
+    ->Arg(100000)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK(BM_PlaneToCapDirect)
+    ->Name("PlaneToCapDirect")
+    ->Arg(5775)
+    ->Arg(20000)
+    ->Arg(50000)
+    ->Arg(100000)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK(BM_PlaneToCapMultigrid)
+    ->Name("PlaneToCapMultigrid")
+    ->Arg(5775)
+    ->Arg(20000)
+    ->Arg(50000)
     ->Arg(100000)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();

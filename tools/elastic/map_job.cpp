@@ -166,6 +166,8 @@ nlohmann::json map_report(const MapJob& job, const MapSession& session,
           {"springs_angular", s.angular_springs},
           {"boundary_particles", s.boundary_particles},
           {"solver", job.solver},
+          {"preconditioner", x.solver == SolverKind::Fast ? std::string(to_string(x.preconditioner))
+                                                          : std::string("none")},
           {"iterations", x.iterations},
           {"converged", x.converged},
           {"reason", std::string(to_string(x.reason))},

@@ -64,65 +64,6 @@ struct InteriorLayout {
   }
 };
 
-// The parameter-space tangent basis of a surface point: d(position)/du and d/dv.
-struct Tangent {
-  Eigen::Vector3d du = Eigen::Vector3d::Zero();
-  Eigen::Vector3d dv = Eigen::Vector3d::Zero();
-  Eigen::Vector3d duu = Eigen::Vector3d::Zero();
-  Eigen::Vector3d duv = Eigen::Vector3d::Zero();
-  Eigen::Vector3d dvv = Eigen::Vector3d::Zero();
-};
-
-Tangent tangent_frame(const SurfaceDerivatives& d) {
-  return {d.du, d.dv, d.duu, d.duv, d.dvv};
-}
-Tangent tangent_frame(const LimitSurface& surface, const SurfacePoint& point) {
-  return tangent_frame(surface.derivatives(point));
-}
-
-// The retraction of the line search: a tangent step t at surface point `from` becomes the
-// parameter step delta = (J^T J)^-1 J^T t, J = [du dv] (the least-squares pull-back of t), walked
-// across ptex faces (LimitSurface::walk), and the particle goes to the limit position there. To
-// first order in |t| this is x + t, as is the closest point of x + t (the magnet): both are
-// retractions, and a minimum of the energy on the surface does not depend on which one the line
-// search uses. This one costs one patch evaluation per particle, against the Newton iterations of
-// the closest-point query. Returns false, leaving the magnet to the caller, when the
-// parameterisation is degenerate at either end or the walk stops on the surface boundary.
-bool parametric_step(const LimitSurface& surface, const SurfacePoint& from, const Tangent& frame,
-                     const Eigen::Vector3d& t, ClosestPoint& out, Tangent& out_frame) {
-  const double a = frame.du.squaredNorm(), b = frame.du.dot(frame.dv), c = frame.dv.squaredNorm();
-  const double det = a * c - b * b;
-  // det = |du x dv|^2: relative to a c it is sin^2 of the angle between du and dv.
-  if (!(det > 1e-12 * a * c)) return false;
-  // Least-squares pull-back of a 3D vector into the parameter plane: (J^T J)^-1 J^T w.
-  const auto pull_back = [&](const Eigen::Vector3d& w) {
-    const double wu = frame.du.dot(w), wv = frame.dv.dot(w);
-    return Eigen::Vector2d((c * wu - b * wv) / det, (a * wv - b * wu) / det);
-  };
-  // Second order: d(delta) = x + J delta + 1/2 delta^T H delta + O(delta^3). Removing the tangent
-  // part of the quadratic term makes the tangent displacement t + O(|t|^3), like the closest point
-  // of x + t, so the L-BFGS pairs see the same curvature as with the magnet.
-  const Eigen::Vector2d first = pull_back(t);
-  const Eigen::Vector3d bend =
-      0.5 * (first.x() * first.x() * frame.duu + 2.0 * first.x() * first.y() * frame.duv +
-             first.y() * first.y() * frame.dvv);
-  const Eigen::Vector2d delta = first - pull_back(bend);
-  const SurfacePoint to = surface.walk(from, delta);
-  if (surface.on_boundary(to)) return false;
-  const SurfaceDerivatives d = surface.derivatives(to);
-  const Eigen::Vector3d normal = d.du.cross(d.dv);
-  const double length = normal.norm();
-  if (!(length > 1e-6 * d.du.norm() * d.dv.norm())) return false;
-  out.point = to;
-  out.position = d.position;
-  out.normal = normal / length;
-  out.distance = 0.0;
-  out.on_boundary = false;
-  out.converged = true;
-  out_frame = tangent_frame(d);
-  return true;
-}
-
 struct Pair {
   Eigen::VectorXd s, y;
   double rho = 0.0;  // 1 / (s . y)
@@ -156,9 +97,11 @@ RelaxationResult relax_lbfgs(const RelaxationProblem& problem, const RelaxationO
     return result;
   }
 
-  // H0 = L^-1: the interior spring Laplacian, ordered by nested dissection and factorised once.
-  const solver_detail::LaplacianFactor laplacian(solver_detail::interior_laplacian(setup, options),
-                                                 solver_detail::interior_coordinates(setup));
+  // H0 = L^-1, L the interior spring Laplacian: factorised once in nested-dissection order, or
+  // approximated by a multigrid V-cycle on large grids (LbfgsOptions::preconditioner).
+  const solver_detail::LaplacianInverse laplacian(solver_detail::interior_laplacian(setup, options),
+                                                  solver_detail::interior_coordinates(setup), lb);
+  result.preconditioner = laplacian.kind();
 
   // Held particles (see the file comment of lbfgs_solver.h): interior particles that the line
   // search stopped from folding a face. They stay where they are, like boundary particles, until a
@@ -198,9 +141,10 @@ RelaxationResult relax_lbfgs(const RelaxationProblem& problem, const RelaxationO
   std::deque<Pair> memory;
   int stalled = 0;  // consecutive steps that changed the energy by less than its round-off
   // Tangent frames (du, dv) of the interior particles at their current and trial surface points.
-  std::vector<Tangent> frames(static_cast<std::size_t>(n)), trial_frames(frames.size());
+  std::vector<solver_detail::TangentFrame> frames(static_cast<std::size_t>(n)),
+      trial_frames(frames.size());
   tbb::parallel_for(Eigen::Index{0}, n, [&](Eigen::Index k) {
-    frames[static_cast<std::size_t>(k)] = tangent_frame(
+    frames[static_cast<std::size_t>(k)] = solver_detail::tangent_frame(
         setup.target.surface(),
         setup.points[static_cast<std::size_t>(setup.interior[static_cast<std::size_t>(k)])]);
   });
@@ -295,7 +239,7 @@ RelaxationResult relax_lbfgs(const RelaxationProblem& problem, const RelaxationO
               const auto p = static_cast<std::size_t>(setup.interior[kk]);
               const Eigen::Vector3d step = alpha * layout.at(direction, k);
               ClosestPoint& out = projected[kk];
-              Tangent& frame = trial_frames[kk];
+              solver_detail::TangentFrame& frame = trial_frames[kk];
               if (step.isZero(0.0)) {  // blocked (or converged) particle: exactly where it is
                 out.point = setup.points[p];
                 out.position = setup.positions.col(static_cast<Eigen::Index>(p));
@@ -303,13 +247,15 @@ RelaxationResult relax_lbfgs(const RelaxationProblem& problem, const RelaxationO
                 frame = frames[kk];
                 continue;
               }
-              if (!parametric_step(setup.target.surface(), setup.points[p], frames[kk], step, out,
-                                   frame)) {
+              if (!solver_detail::parametric_retraction(
+                      setup.target.surface(), setup.points[p],
+                      setup.positions.col(static_cast<Eigen::Index>(p)), frames[kk], step, out,
+                      frame)) {
                 // Magnet fallback: the closest point of x + alpha p, warm started.
                 out = setup.target.closest(
                     Eigen::Vector3d(setup.positions.col(static_cast<Eigen::Index>(p)) + step),
                     setup.points[p]);
-                frame = tangent_frame(setup.target.surface(), out.point);
+                frame = solver_detail::tangent_frame(setup.target.surface(), out.point);
               }
             }
           });

@@ -21,6 +21,26 @@ SolverKind parse_solver_kind(std::string_view text, std::string_view input) {
                           "unknown solver '" + std::string(text) + "' (expected fast or faithful)");
 }
 
+std::string_view to_string(Preconditioner kind) {
+  switch (kind) {
+    case Preconditioner::Auto:
+      return "auto";
+    case Preconditioner::Direct:
+      return "direct";
+    case Preconditioner::Multigrid:
+      return "multigrid";
+  }
+  return "unknown";
+}
+
+Preconditioner parse_preconditioner(std::string_view text, std::string_view input) {
+  if (text == "auto") return Preconditioner::Auto;
+  if (text == "direct") return Preconditioner::Direct;
+  if (text == "multigrid") return Preconditioner::Multigrid;
+  throw InvalidInputError(std::string(input), "unknown preconditioner '" + std::string(text) +
+                                                  "' (expected auto, direct or multigrid)");
+}
+
 std::string_view to_string(StopReason reason) {
   switch (reason) {
     case StopReason::RelativeGradient:

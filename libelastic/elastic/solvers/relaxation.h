@@ -30,6 +30,7 @@
 #include "elastic/particles/particle_grid.h"
 #include "elastic/particles/spring_energy.h"
 #include "elastic/projection/closest_point.h"
+#include "elastic/solvers/multigrid.h"
 #include "elastic/surface/surface_point.h"
 
 namespace elastic {
@@ -86,11 +87,29 @@ struct ExplicitOptions {
                                   ///< the mean rest length from the surface
 };
 
+/// How the L-BFGS solver applies its initial inverse Hessian H0 ~ L^-1 (L the interior spring
+/// Laplacian, solver_common.h).
+enum class Preconditioner {
+  Auto,      ///< Direct up to LbfgsOptions::direct_limit interior particles, Multigrid above
+  Direct,    ///< exact: sparse LDL^T in nested-dissection order, factorised once (O(n^1.5))
+  Multigrid  ///< one algebraic-multigrid V-cycle (multigrid.h): O(n) set-up and application
+};
+/// "auto", "direct", "multigrid".
+std::string_view to_string(Preconditioner kind);
+/// Parses "auto", "direct" or "multigrid". \throws InvalidInputError naming `input` otherwise.
+Preconditioner parse_preconditioner(std::string_view text,
+                                    std::string_view input = "preconditioner");
+
 /// Options of the L-BFGS solver.
 struct LbfgsOptions {
   int memory = 8;           ///< number of (s, y) pairs kept
   double armijo = 1e-4;     ///< sufficient-decrease constant c1 of the Armijo condition
   int max_backtracks = 40;  ///< step halvings per line search before giving up
+  Preconditioner preconditioner = Preconditioner::Auto;  ///< how H0 = L^-1 is applied
+  /// Auto chooses Direct up to this many interior particles (below it the factorisation is cheaper
+  /// than the V-cycles: docs/solvers.md has the measurements).
+  int direct_limit = 30000;
+  MultigridOptions multigrid;  ///< the V-cycle's parameters (Preconditioner::Multigrid)
 };
 
 struct RelaxationOptions {
@@ -132,6 +151,8 @@ struct RelaxationResult {
   long evaluations = 0;  ///< energy evaluations (L-BFGS line-search trials included)
   bool converged = false;
   StopReason reason = StopReason::MaxIterations;
+  /// L-BFGS: the H0 actually used (Direct or Multigrid; Auto never appears here).
+  Preconditioner preconditioner = Preconditioner::Auto;
   double setup_seconds = 0.0;   ///< incidence tables, Laplacian factorisation, normals
   double solve_seconds = 0.0;   ///< the iterations
   double initial_energy = 0.0;  ///< E_len + E_ang at the start

@@ -314,6 +314,131 @@ Eigen::VectorXd LaplacianFactor::solve3(const Eigen::VectorXd& b) const {
   return r;
 }
 
+TangentFrame tangent_frame(const SurfaceDerivatives& d) {
+  return {d.du, d.dv, d.duu, d.duv, d.dvv};
+}
+TangentFrame tangent_frame(const LimitSurface& surface, const SurfacePoint& point) {
+  return tangent_frame(surface.derivatives(point));
+}
+
+namespace {
+
+// Least-squares pull-back of a 3D vector w into the parameter plane of `frame`:
+// (J^T J)^-1 J^T w, J = [du dv]. False when du and dv are (nearly) parallel.
+bool pull_back(const TangentFrame& frame, const Eigen::Vector3d& w, Eigen::Vector2d& out) {
+  const double a = frame.du.squaredNorm(), b = frame.du.dot(frame.dv), c = frame.dv.squaredNorm();
+  const double det = a * c - b * b;
+  // det = |du x dv|^2: relative to a c it is sin^2 of the angle between du and dv.
+  if (!(det > 1e-12 * a * c)) return false;
+  const double wu = frame.du.dot(w), wv = frame.dv.dot(w);
+  out = Eigen::Vector2d((c * wu - b * wv) / det, (a * wv - b * wu) / det);
+  return true;
+}
+
+// Evaluates `to` into `out` and `out_frame`; false where the parameterisation is degenerate.
+bool land(const LimitSurface& surface, const SurfacePoint& to, ClosestPoint& out,
+          TangentFrame& out_frame) {
+  const SurfaceDerivatives d = surface.derivatives(to);
+  const Eigen::Vector3d normal = d.du.cross(d.dv);
+  const double length = normal.norm();
+  if (!(length > 1e-6 * d.du.norm() * d.dv.norm())) return false;
+  out.point = to;
+  out.position = d.position;
+  out.normal = normal / length;
+  out.distance = 0.0;
+  out.on_boundary = false;
+  out.converged = true;
+  out_frame = tangent_frame(d);
+  return true;
+}
+
+// Gauss-Newton steps of the landing point towards the foot of `goal` (the closest point of goal
+// near it) while the tangential miss exceeds this fraction of the step.
+constexpr double kRetractionMiss = 1e-3;
+constexpr int kRetractionCorrections = 3;
+
+}  // namespace
+
+// The retraction of the line search: a tangent step t at surface point `from` (position x)
+// becomes the parameter step delta = (J^T J)^-1 J^T t, J = [du dv] (the least-squares pull-back
+// of t), walked across ptex faces (LimitSurface::walk), and the particle goes to the limit position
+// there. To first order in |t| this is x + t, as is the closest point of x + t (the magnet): both
+// are retractions, and a minimum of the energy on the surface does not depend on which one the
+// line search uses. This one costs one patch evaluation per particle, against the Newton
+// iterations of the closest-point query.
+//
+// The walk carries delta across an edge in parameter units, so where the neighbouring face's
+// parameterisation runs at another speed or direction (around an extraordinary vertex, into the
+// sub-faces of a non-quad face) the landing point can miss x + t by O(|t|) along the surface. Such
+// misses fold grids whose spacing is small against the step (seen at 300,000 particles on the cap,
+// around its four extraordinary vertices), so the landing point is checked: if the part of
+// x + t - landing tangent to the surface there exceeds kRetractionMiss |t|, Gauss-Newton steps
+// move it to the foot of x + t, which is the magnet's answer. Returns false, leaving the magnet to
+// the caller, when the parameterisation is degenerate, the walk stops on the surface boundary, or
+// the corrections do not converge.
+bool parametric_retraction(const LimitSurface& surface, const SurfacePoint& from,
+                           const Eigen::Vector3d& x, const TangentFrame& frame,
+                           const Eigen::Vector3d& t, ClosestPoint& out, TangentFrame& out_frame) {
+  Eigen::Vector2d first;
+  if (!pull_back(frame, t, first)) return false;
+  // Second order: d(delta) = x + J delta + 1/2 delta^T H delta + O(delta^3). Removing the tangent
+  // part of the quadratic term makes the tangent displacement t + O(|t|^3), like the closest point
+  // of x + t, so the L-BFGS pairs see the same curvature as with the magnet.
+  const Eigen::Vector3d bend =
+      0.5 * (first.x() * first.x() * frame.duu + 2.0 * first.x() * first.y() * frame.duv +
+             first.y() * first.y() * frame.dvv);
+  Eigen::Vector2d correction;
+  if (!pull_back(frame, bend, correction)) return false;
+  SurfacePoint to = surface.walk(from, first - correction);
+  if (surface.on_boundary(to) || !land(surface, to, out, out_frame)) return false;
+  const Eigen::Vector3d goal = x + t;
+  const double allowed = kRetractionMiss * t.norm();
+  for (int k = 0;; ++k) {
+    const Eigen::Vector3d miss = goal - out.position;
+    const Eigen::Vector3d tangential = miss - out.normal * out.normal.dot(miss);
+    if (tangential.norm() <= allowed) return true;
+    if (k == kRetractionCorrections) return false;
+    Eigen::Vector2d step;
+    if (!pull_back(out_frame, tangential, step)) return false;
+    to = surface.walk(to, step);
+    if (surface.on_boundary(to) || !land(surface, to, out, out_frame)) return false;
+  }
+}
+
+LaplacianInverse::LaplacianInverse(const Eigen::SparseMatrix<double>& laplacian,
+                                   const Eigen::Matrix3Xd& coordinates,
+                                   const LbfgsOptions& options) {
+  if (options.direct_limit < 0) throw InvalidInputError(kName, "direct_limit must be >= 0");
+  kind_ = options.preconditioner;
+  if (kind_ == Preconditioner::Auto)
+    kind_ = laplacian.rows() <= options.direct_limit ? Preconditioner::Direct
+                                                     : Preconditioner::Multigrid;
+  if (kind_ == Preconditioner::Direct) {
+    direct_ = std::make_unique<LaplacianFactor>(laplacian, coordinates);
+    return;
+  }
+  try {
+    multigrid_ = std::make_unique<Multigrid>(laplacian, true, options.multigrid);
+  } catch (const NumericalError&) {
+    // Only a singular Laplacian makes a coarse level indefinite: the same message as the direct
+    // factorisation gives.
+    throw NumericalError(kName,
+                         "the spring Laplacian of the interior particles is singular (an interior "
+                         "part of the grid is not connected to the boundary)");
+  }
+}
+
+Eigen::VectorXd LaplacianInverse::solve3(const Eigen::VectorXd& b) const {
+  if (direct_) return direct_->solve3(b);
+  const Eigen::Index n = multigrid_->size();
+  Multigrid::Block block(n, 3);
+  for (int c = 0; c < 3; ++c) block.col(c) = b.segment(c * n, n);
+  const Multigrid::Block x = multigrid_->apply(block);
+  Eigen::VectorXd r(3 * n);
+  for (int c = 0; c < 3; ++c) r.segment(c * n, n) = x.col(c);
+  return r;
+}
+
 double boundary_residual(const RelaxationProblem& problem, const Eigen::Matrix3Xd& positions) {
   const std::vector<int>& loop = problem.grid->boundary_loop;
   double residual = 0.0;

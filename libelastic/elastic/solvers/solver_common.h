@@ -8,6 +8,7 @@
 #include <Eigen/Core>
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseCore>
+#include <memory>
 #include <vector>
 
 #include "elastic/solvers/relaxation.h"
@@ -87,6 +88,52 @@ class LaplacianFactor {
   Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>, Eigen::Lower, Eigen::NaturalOrdering<int>>
       factor_;
 };
+
+/// H0 = L^-1 of the L-BFGS solver, applied exactly (LaplacianFactor) or by a multigrid V-cycle
+/// (multigrid.h), as LbfgsOptions::preconditioner asks.
+class LaplacianInverse {
+ public:
+  /// `laplacian`: lower triangle stored (interior_laplacian); `coordinates`: 3 x n positions of the
+  /// interior particles (the direct factorisation's ordering).
+  LaplacianInverse(const Eigen::SparseMatrix<double>& laplacian,
+                   const Eigen::Matrix3Xd& coordinates, const LbfgsOptions& options);
+  /// The operator on the three n-blocks of b (x, y, z).
+  Eigen::VectorXd solve3(const Eigen::VectorXd& b) const;
+  /// Direct or Multigrid.
+  Preconditioner kind() const { return kind_; }
+
+ private:
+  Preconditioner kind_ = Preconditioner::Direct;
+  std::unique_ptr<LaplacianFactor> direct_;
+  std::unique_ptr<Multigrid> multigrid_;
+};
+
+/// The parameter-space frame of a surface point: first and second derivatives of the limit
+/// position with respect to the ptex (u, v).
+struct TangentFrame {
+  Eigen::Vector3d du = Eigen::Vector3d::Zero();
+  Eigen::Vector3d dv = Eigen::Vector3d::Zero();
+  Eigen::Vector3d duu = Eigen::Vector3d::Zero();
+  Eigen::Vector3d duv = Eigen::Vector3d::Zero();
+  Eigen::Vector3d dvv = Eigen::Vector3d::Zero();
+};
+TangentFrame tangent_frame(const SurfaceDerivatives& d);
+TangentFrame tangent_frame(const LimitSurface& surface, const SurfacePoint& point);
+
+/// The fast solver's retraction: moves the surface point `from` (limit position `x`, frame
+/// `frame`) by the tangent step `t` along the surface. The step is pulled back into ptex
+/// parameters to second order (delta = (J^T J)^-1 J^T (t - 1/2 delta^T H delta), J = [du dv]),
+/// walked across ptex faces, and evaluated; if the landing point misses x + t tangentially by more
+/// than 1e-3 |t| (the walk carries delta across an edge in parameter units, so around an
+/// extraordinary vertex or into the sub-faces of a non-quad face it can land O(|t|) away),
+/// Gauss-Newton steps move it to the foot of x + t on the surface, which is the magnet's answer.
+/// To first order both are x + t: a retraction. On success fills `out` (point, position, unit
+/// normal) and `out_frame`; returns false (the caller then uses the magnet) when the
+/// parameterisation is degenerate, the walk stops on the surface boundary, or three corrections do
+/// not reach the tolerance.
+bool parametric_retraction(const LimitSurface& surface, const SurfacePoint& from,
+                           const Eigen::Vector3d& x, const TangentFrame& frame,
+                           const Eigen::Vector3d& t, ClosestPoint& out, TangentFrame& out_frame);
 
 /// Fills the final measurements of `result` from the setup's current positions, points and normals:
 /// energies, tangential gradient (relative to `initial_gradient_norm`), folds, boundary residual,
