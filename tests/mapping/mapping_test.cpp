@@ -198,6 +198,38 @@ TEST_F(MappingTest, RoundTripIsExactUpToTheCapsSagitta) {
   }
 }
 
+// Above an interior grid edge on the curved side the two triangles' planes leave a gap or overlap
+// (the grid bends there), so the query's projection can fall outside both; the answer must still be
+// the edge's point: the image of the cap's point above a target edge's midpoint is the source
+// edge's midpoint, to the same sagitta-times-tilt bound as the round trip (h^3 kappa^2 / 4, see
+// above).
+TEST_F(MappingTest, AboveAGridEdgeTheInverseIsContinuous) {
+  const MapResult& result = pair_->plane_to_cap;
+  const Eigen::Matrix3Xd source = source_particles(result);
+  const Eigen::Matrix3Xd& target = result.relaxation.positions;
+  const auto& triangles = result.mapping.triangles();
+  const double h = longest_edge(target, triangles);
+  std::set<std::pair<int, int>> directed;
+  for (const Eigen::Vector3i& t : triangles) {
+    for (int k = 0; k < 3; ++k) directed.emplace(t[k], t[(k + 1) % 3]);
+  }
+  int checked = 0, on_edge = 0;
+  for (const auto& [a, b] : directed) {
+    if (a > b || directed.count({b, a}) == 0) continue;  // each interior edge once
+    const ClosestPoint q = pair_->cap.closest(0.5 * (target.col(a) + target.col(b)),
+                                              result.relaxation.points[static_cast<size_t>(a)]);
+    const Mapping::Location back = result.mapping.inverse(q.point);
+    ASSERT_TRUE(back.inside) << "edge " << a << "-" << b;
+    EXPECT_LT((back.position - 0.5 * (source.col(a) + source.col(b))).norm(), 0.25 * h * h * h)
+        << "edge " << a << "-" << b;
+    on_edge += back.barycentric.minCoeff() == 0.0 ? 1 : 0;  // clamped onto the edge
+    ++checked;
+  }
+  EXPECT_GT(checked, 300);
+  RecordProperty("clamped_onto_edge", on_edge);
+  RecordProperty("interior_edges", checked);
+}
+
 // "Outside" means outside the region: points of the plane beyond the disk answer outside both
 // ways. Just inside a boundary edge of the grid (1e-6 of its length, in its plane) is inside in 3D,
 // whatever the disk maps say there, and is answered from that boundary triangle; just outside it
