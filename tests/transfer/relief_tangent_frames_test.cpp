@@ -222,7 +222,10 @@ TEST(ReliefFrames, RigidMapOfACylinderRotatesTangentVectors) {
   target_spec.center = motion * source_spec.center;
   target_spec.anchor = motion * *source_spec.anchor;
   const auto m = map_pair(cylinder, test::moved(cylinder, motion), source_spec, target_spec);
-  ASSERT_TRUE(m->result.relaxation.converged);
+  ASSERT_TRUE(m->result.relaxation.converged)
+      << to_string(m->result.relaxation.reason) << ", relative gradient "
+      << m->result.relaxation.relative_gradient << ", held "
+      << m->result.relaxation.held_particles.size();
   const Eigen::Matrix3d rotation = motion.linear();
   // How congruent the relaxed grid is to the source grid. On this curved surface the boundary
   // particles' arc-length placement is off the rigid image by ~2e-4 (chords of the cut curve vs

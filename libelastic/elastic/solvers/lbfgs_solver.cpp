@@ -2,15 +2,18 @@
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
 
 #include <Eigen/Geometry>
 #include <Eigen/SparseCholesky>
 #include <algorithm>
 #include <cmath>
 #include <deque>
+#include <functional>
 #include <limits>
 
 #include "elastic/core/error.h"
+#include "elastic/core/huge_pages.h"
 #include "elastic/solvers/solver_common.h"
 
 namespace elastic {
@@ -29,34 +32,66 @@ constexpr int kMaxReleases = 1;
 // Consecutive steps without an energy change beyond round-off before the solver gives up.
 constexpr int kMaxStalled = 20;
 
+// Vector kernels over [0, n) in fixed chunks. Reductions join the chunks' partial sums in a fixed
+// tree (parallel_deterministic_reduce), so every result is the same for any number of threads; at
+// a million particles the serial Eigen versions of these passes took about a third of an
+// iteration.
+constexpr Eigen::Index kChunk = 16384;
+
+template <typename Body>
+void for_chunks(Eigen::Index n, const Body& body) {
+  tbb::parallel_for(tbb::blocked_range<Eigen::Index>(0, n, kChunk),
+                    [&](const tbb::blocked_range<Eigen::Index>& r) {
+                      for (Eigen::Index i = r.begin(); i != r.end(); ++i) body(i);
+                    });
+}
+
+template <typename Term>
+double sum_chunks(Eigen::Index n, const Term& term) {
+  return tbb::parallel_deterministic_reduce(
+      tbb::blocked_range<Eigen::Index>(0, n, kChunk), 0.0,
+      [&](const tbb::blocked_range<Eigen::Index>& r, double sum) {
+        for (Eigen::Index i = r.begin(); i != r.end(); ++i) sum += term(i);
+        return sum;
+      },
+      std::plus<double>());
+}
+
+double dot(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
+  return sum_chunks(a.size(), [&](Eigen::Index i) { return a[i] * b[i]; });
+}
+
+// y += alpha x
+void axpy(double alpha, const Eigen::VectorXd& x, Eigen::VectorXd& y) {
+  for_chunks(x.size(), [&](Eigen::Index i) { y[i] += alpha * x[i]; });
+}
+
 // Interior vectors have 3n entries laid out as an n x 3 column-major matrix (all x, then all y,
 // then all z), so that the Laplacian solve takes the three coordinates as three right-hand sides.
 struct InteriorLayout {
   const RelaxationSetup* setup;
   Eigen::Index n;
 
-  // Tangential part of the gradient at the interior particles: g_i - n_i (n_i . g_i).
-  Eigen::VectorXd tangential(const Eigen::Matrix3Xd& gradient,
-                             const Eigen::Matrix3Xd& normals) const {
-    Eigen::VectorXd q(3 * n);
-    for (Eigen::Index k = 0; k < n; ++k) {
+  // q = tangential part of the gradient at the interior particles: g_i - n_i (n_i . g_i).
+  void tangential(const Eigen::Matrix3Xd& gradient, const Eigen::Matrix3Xd& normals,
+                  Eigen::VectorXd& q) const {
+    for_chunks(n, [&](Eigen::Index k) {
       const int p = setup->interior[static_cast<std::size_t>(k)];
       const Eigen::Vector3d g = gradient.col(p);
       const Eigen::Vector3d nrm = normals.col(p);
       const Eigen::Vector3d t = g - nrm * nrm.dot(g);
       for (int c = 0; c < 3; ++c) q[c * n + k] = t[c];
-    }
-    return q;
+    });
   }
 
   void project(Eigen::VectorXd& v, const Eigen::Matrix3Xd& normals) const {
-    for (Eigen::Index k = 0; k < n; ++k) {
+    for_chunks(n, [&](Eigen::Index k) {
       const int p = setup->interior[static_cast<std::size_t>(k)];
       const Eigen::Vector3d nrm = normals.col(p);
       const Eigen::Vector3d t(v[k], v[n + k], v[2 * n + k]);
       const Eigen::Vector3d u = t - nrm * nrm.dot(t);
       for (int c = 0; c < 3; ++c) v[c * n + k] = u[c];
-    }
+    });
   }
 
   Eigen::Vector3d at(const Eigen::VectorXd& v, Eigen::Index k) const {
@@ -82,9 +117,11 @@ RelaxationResult relax_lbfgs(const RelaxationProblem& problem, const RelaxationO
   result.solver = SolverKind::Fast;
   const long max_iterations = options.max_iterations > 0 ? options.max_iterations : 2000;
   const Eigen::Index n = setup.num_free();
+  const Eigen::Index m = 3 * n;
   const InteriorLayout layout{&setup, n};
 
   Eigen::Matrix3Xd gradient;
+  resize_huge(gradient, 3, setup.num_particles);
   SpringEnergies energies = setup.springs.evaluate(setup.positions, &gradient);
   result.initial_energy = energies.total();
   result.evaluations = 1;
@@ -110,46 +147,80 @@ RelaxationResult relax_lbfgs(const RelaxationProblem& problem, const RelaxationO
   std::vector<char> held(static_cast<std::size_t>(n), 0);
   Eigen::Index held_count = 0;
   int releases = 0;
+  const auto is_held = [&](Eigen::Index i) { return held[static_cast<std::size_t>(i % n)] != 0; };
   const auto mask = [&](Eigen::VectorXd& v) {
     if (held_count == 0) return;
-    for (Eigen::Index k = 0; k < n; ++k)
-      if (held[static_cast<std::size_t>(k)])
-        for (int d = 0; d < 3; ++d) v[d * n + k] = 0.0;
+    for_chunks(m, [&](Eigen::Index i) {
+      if (is_held(i)) v[i] = 0.0;
+    });
   };
-  const auto apply_h0 = [&](Eigen::VectorXd v) {
-    mask(v);
-    v = laplacian.solve3(v);
-    mask(v);
-    return v;
+  // The norm of the rows that are not held.
+  const auto free_norm = [&](const Eigen::VectorXd& v) {
+    if (held_count == 0) return std::sqrt(dot(v, v));
+    return std::sqrt(sum_chunks(m, [&](Eigen::Index i) { return is_held(i) ? 0.0 : v[i] * v[i]; }));
   };
-  // The tangential gradient of the particles that are not held.
-  const auto free_part = [&](const Eigen::VectorXd& v) {
-    Eigen::VectorXd w = v;
-    mask(w);
-    return w;
+  // out = masked L^-1 (masked v); v is masked in place.
+  Eigen::VectorXd solved;
+  resize_huge(solved, m, 1);
+  const auto apply_h0 = [&](Eigen::VectorXd& v) {
+    mask(v);
+    laplacian.solve3(v, solved);
+    v.swap(solved);
+    mask(v);
   };
 
   std::vector<char> folded;
   setup.springs.folded_corners(setup.positions, setup.normals, folded);
 
-  Eigen::VectorXd q = layout.tangential(gradient, setup.normals);
-  double q_norm = q.norm();
+  // Round-off of an energy evaluation. Each term C (|d| - k)^2 carries an error of about
+  // 2 C |e| delta, e = |d| - k, delta the error of |d|: a few ulps of the coordinates, i.e.
+  // eps (k + extent) for particles at distance `extent` from the origin. Summed linearly and by
+  // Cauchy-Schwarz: 2 eps (1 + extent / k) sqrt(E S), S = sum C k^2 over all springs. Near a
+  // perfect map (E -> 0) this floor falls only like sqrt(E), far slower than E, and line-search
+  // trials that differ from E by less than it are decided on the gradient instead.
+  double rest_sum = 0.0;
+  for (const Spring& spring : setup.grid.springs)
+    rest_sum += options.stiffness * spring.rest * spring.rest;
+  for (const AngularSpring& spring : setup.grid.angular_springs)
+    rest_sum += options.angular_stiffness * spring.rest * spring.rest;
+  rest_sum *= problem.rest_scale * problem.rest_scale;
+  const double extent = setup.positions.cwiseAbs().maxCoeff();
+  const double noise_factor = 8.0 * std::numeric_limits<double>::epsilon() *
+                              (1.0 + extent / std::max(setup.mean_rest, 1e-300)) *
+                              std::sqrt(rest_sum);
+  const auto round_off = [&](double energy) {
+    return std::max(1e-13 * energy, noise_factor * std::sqrt(std::max(energy, 0.0)));
+  };
+
+  // The solver's vectors, allocated once (see core/huge_pages.h for why that matters at scale).
+  Eigen::VectorXd q, q_free, direction, trial_q;
+  for (Eigen::VectorXd* v : {&q, &q_free, &direction, &trial_q}) resize_huge(*v, m, 1);
+  layout.tangential(gradient, setup.normals, q);
+  double q_norm = std::sqrt(dot(q, q));
   const double initial_norm = q_norm;
   result.setup_seconds = solver_detail::seconds_since(start);
   const long long solve_start = solver_detail::now_ticks();
 
   std::deque<Pair> memory;
+  Pair next;        // storage of the next (s, y) pair; the oldest pair's once the memory is full
   int stalled = 0;  // consecutive steps that changed the energy by less than its round-off
   // Tangent frames (du, dv) of the interior particles at their current and trial surface points.
   std::vector<solver_detail::TangentFrame> frames(static_cast<std::size_t>(n)),
       trial_frames(frames.size());
-  tbb::parallel_for(Eigen::Index{0}, n, [&](Eigen::Index k) {
+  for_chunks(n, [&](Eigen::Index k) {
     frames[static_cast<std::size_t>(k)] = solver_detail::tangent_frame(
         setup.target.surface(),
         setup.points[static_cast<std::size_t>(setup.interior[static_cast<std::size_t>(k)])]);
   });
-  std::vector<ClosestPoint> projected(static_cast<std::size_t>(n));
+  // The trial state. Boundary particles never move, so their columns are copied once here and stay
+  // equal in both buffers through the swaps; the retraction writes the interior columns.
   Eigen::Matrix3Xd trial_positions, trial_normals, trial_gradient;
+  resize_huge(trial_positions, 3, setup.num_particles);
+  resize_huge(trial_normals, 3, setup.num_particles);
+  resize_huge(trial_gradient, 3, setup.num_particles);
+  trial_positions = setup.positions;
+  trial_normals = setup.normals;
+  std::vector<SurfacePoint> trial_points = setup.points;
   std::vector<char> trial_folded;
 
   const auto emit_frame = [&](long iteration) {
@@ -170,11 +241,12 @@ RelaxationResult relax_lbfgs(const RelaxationProblem& problem, const RelaxationO
       result.reason = StopReason::AbsoluteGradient;
       break;
     }
-    Eigen::VectorXd q_free = free_part(q);
+    q_free = q;
+    mask(q_free);
     if (held_count > 0) {
-      const double free_norm = q_free.norm();
-      if (free_norm <= options.relative_gradient_tolerance * initial_norm ||
-          free_norm <= setup.absolute_bound) {
+      const double norm = std::sqrt(dot(q_free, q_free));
+      if (norm <= options.relative_gradient_tolerance * initial_norm ||
+          norm <= setup.absolute_bound) {
         // Every particle that is not held is at equilibrium. Release the held ones once: if the
         // energy lets them move away from the fold, the solver goes on; if they are held again and
         // the rest settles again, the minimum lies beyond the no-fold constraint.
@@ -204,77 +276,71 @@ RelaxationResult relax_lbfgs(const RelaxationProblem& problem, const RelaxationO
     }
 
     // Two-loop recursion with H0 = L^-1 (newest pair first, then back).
-    Eigen::VectorXd direction = q_free;
+    direction = q_free;
     std::vector<double> alphas(memory.size());
-    for (std::size_t m = memory.size(); m-- > 0;) {
-      alphas[m] = memory[m].rho * memory[m].s.dot(direction);
-      direction -= alphas[m] * memory[m].y;
+    for (std::size_t k = memory.size(); k-- > 0;) {
+      alphas[k] = memory[k].rho * dot(memory[k].s, direction);
+      axpy(-alphas[k], memory[k].y, direction);
     }
-    direction = apply_h0(direction);
-    for (std::size_t m = 0; m < memory.size(); ++m) {
-      const double beta = memory[m].rho * memory[m].y.dot(direction);
-      direction += (alphas[m] - beta) * memory[m].s;
+    apply_h0(direction);
+    for (std::size_t k = 0; k < memory.size(); ++k) {
+      const double beta = memory[k].rho * dot(memory[k].y, direction);
+      axpy(alphas[k] - beta, memory[k].s, direction);
     }
     direction = -direction;
     layout.project(direction, setup.normals);
-    double slope = q_free.dot(direction);
+    double slope = dot(q_free, direction);
     if (!(slope < 0.0)) {
       memory.clear();
-      direction = -apply_h0(q_free);
+      direction = q_free;
+      apply_h0(direction);
+      direction = -direction;
       layout.project(direction, setup.normals);
-      slope = q_free.dot(direction);
+      slope = dot(q_free, direction);
       if (!(slope < 0.0)) {  // L is SPD, so only round-off gets here: fall back to steepest descent
         direction = -q_free;
-        slope = -q_free.squaredNorm();
+        slope = -dot(q_free, q_free);
       }
     }
 
-    // Backtracking line search along the retraction (see retract above).
+    // Backtracking line search along the retraction (solver_detail::parametric_retraction, the
+    // magnet where it declines).
     const auto retract = [&](double alpha) {
-      tbb::parallel_for(
-          tbb::blocked_range<Eigen::Index>(0, n, 1024),
-          [&](const tbb::blocked_range<Eigen::Index>& range) {
-            for (Eigen::Index k = range.begin(); k != range.end(); ++k) {
-              const auto kk = static_cast<std::size_t>(k);
-              const auto p = static_cast<std::size_t>(setup.interior[kk]);
-              const Eigen::Vector3d step = alpha * layout.at(direction, k);
-              ClosestPoint& out = projected[kk];
-              solver_detail::TangentFrame& frame = trial_frames[kk];
-              if (step.isZero(0.0)) {  // blocked (or converged) particle: exactly where it is
-                out.point = setup.points[p];
-                out.position = setup.positions.col(static_cast<Eigen::Index>(p));
-                out.normal = setup.normals.col(static_cast<Eigen::Index>(p));
-                frame = frames[kk];
-                continue;
-              }
-              if (!solver_detail::parametric_retraction(
-                      setup.target.surface(), setup.points[p],
-                      setup.positions.col(static_cast<Eigen::Index>(p)), frames[kk], step, out,
-                      frame)) {
-                // Magnet fallback: the closest point of x + alpha p, warm started.
-                out = setup.target.closest(
-                    Eigen::Vector3d(setup.positions.col(static_cast<Eigen::Index>(p)) + step),
-                    setup.points[p]);
-                frame = solver_detail::tangent_frame(setup.target.surface(), out.point);
-              }
-            }
-          });
+      for_chunks(n, [&](Eigen::Index k) {
+        const auto kk = static_cast<std::size_t>(k);
+        const auto p = static_cast<std::size_t>(setup.interior[kk]);
+        const auto col = static_cast<Eigen::Index>(p);
+        const Eigen::Vector3d step = alpha * layout.at(direction, k);
+        solver_detail::TangentFrame& frame = trial_frames[kk];
+        if (step.isZero(0.0)) {  // blocked (or converged) particle: exactly where it is
+          trial_points[p] = setup.points[p];
+          trial_positions.col(col) = setup.positions.col(col);
+          trial_normals.col(col) = setup.normals.col(col);
+          frame = frames[kk];
+          return;
+        }
+        ClosestPoint out;
+        if (!solver_detail::parametric_retraction(setup.target.surface(), setup.points[p],
+                                                  setup.positions.col(col), frames[kk], step, out,
+                                                  frame)) {
+          // Magnet fallback: the closest point of x + alpha p, warm started.
+          out = setup.target.closest(Eigen::Vector3d(setup.positions.col(col) + step),
+                                     setup.points[p]);
+          frame = solver_detail::tangent_frame(setup.target.surface(), out.point);
+        }
+        trial_points[p] = out.point;
+        trial_positions.col(col) = out.position;
+        trial_normals.col(col) = out.normal;
+      });
     };
     bool accepted = false;
+    bool trial_q_ready = false;
     double alpha = 1.0;
     SpringEnergies trial_energies;
-    Eigen::VectorXd trial_q;
     int backtracks = 0, block_rounds = 0, fold_halvings = 0;
     while (backtracks < lb.max_backtracks && slope < 0.0) {
-      trial_q.resize(0);
+      trial_q_ready = false;
       retract(alpha);
-      trial_positions = setup.positions;
-      trial_normals = setup.normals;
-      for (Eigen::Index k = 0; k < n; ++k) {
-        const int p = setup.interior[static_cast<std::size_t>(k)];
-        trial_positions.col(p) = projected[static_cast<std::size_t>(k)].position;
-        trial_normals.col(p) = projected[static_cast<std::size_t>(k)].normal;
-      }
       setup.springs.folded_corners(trial_positions, trial_normals, trial_folded);
       // A first few folding trials only shorten the step; then the folding particles are blocked.
       const bool block_now = fold_halvings >= kFoldHalvings && block_rounds < kMaxBlockRounds;
@@ -302,10 +368,13 @@ RelaxationResult relax_lbfgs(const RelaxationProblem& problem, const RelaxationO
           // the masked L^-1 is positive semi-definite and positive on the free rows.
           ++block_rounds;
           memory.clear();
-          q_free = free_part(q);
-          direction = -apply_h0(q_free);
+          q_free = q;
+          mask(q_free);
+          direction = q_free;
+          apply_h0(direction);
+          direction = -direction;
           layout.project(direction, setup.normals);
-          slope = q_free.dot(direction);
+          slope = dot(q_free, direction);
         } else {
           alpha *= 0.5;
           ++backtracks;
@@ -320,10 +389,11 @@ RelaxationResult relax_lbfgs(const RelaxationProblem& problem, const RelaxationO
       if (std::isfinite(trial_energy)) {
         if (trial_energy <= energy + lb.armijo * alpha * slope) {
           accepted = true;
-        } else if (trial_energy <= energy + 1e-13 * energy) {
+        } else if (trial_energy <= energy + round_off(energy)) {
           // Within round-off of the current energy: accept on a smaller tangential gradient.
-          trial_q = layout.tangential(trial_gradient, trial_normals);
-          accepted = free_part(trial_q).norm() < q_free.norm();
+          layout.tangential(trial_gradient, trial_normals, trial_q);
+          trial_q_ready = true;
+          accepted = free_norm(trial_q) < std::sqrt(dot(q_free, q_free));
         }
       }
       if (accepted) break;
@@ -339,35 +409,43 @@ RelaxationResult relax_lbfgs(const RelaxationProblem& problem, const RelaxationO
       break;
     }
 
-    if (trial_q.size() == 0) trial_q = layout.tangential(trial_gradient, trial_normals);
-    Pair pair;
-    pair.s.resize(3 * n);
-    for (Eigen::Index k = 0; k < n; ++k) {
-      const int p = setup.interior[static_cast<std::size_t>(k)];
-      const Eigen::Vector3d step = trial_positions.col(p) - setup.positions.col(p);
-      for (int c = 0; c < 3; ++c) pair.s[c * n + k] = step[c];
+    if (!trial_q_ready) layout.tangential(trial_gradient, trial_normals, trial_q);
+    if (next.s.size() != m) {
+      resize_huge(next.s, m, 1);
+      resize_huge(next.y, m, 1);
     }
-    pair.y = free_part(trial_q) - q_free;
-    const double sy = pair.s.dot(pair.y);
-    if (sy > 1e-12 * pair.s.norm() * pair.y.norm() && lb.memory > 0) {
-      pair.rho = 1.0 / sy;
-      memory.push_back(std::move(pair));
-      if (memory.size() > static_cast<std::size_t>(lb.memory)) memory.pop_front();
+    for_chunks(n, [&](Eigen::Index k) {
+      const auto p = static_cast<Eigen::Index>(setup.interior[static_cast<std::size_t>(k)]);
+      const bool free = !held[static_cast<std::size_t>(k)];
+      for (int c = 0; c < 3; ++c) {
+        next.s[c * n + k] = trial_positions(c, p) - setup.positions(c, p);
+        // y = (free part of the new gradient) - (free part of the old one)
+        next.y[c * n + k] = free ? trial_q[c * n + k] - q_free[c * n + k] : 0.0;
+      }
+    });
+    const double sy = dot(next.s, next.y);
+    if (sy > 1e-12 * std::sqrt(dot(next.s, next.s) * dot(next.y, next.y)) && lb.memory > 0) {
+      next.rho = 1.0 / sy;
+      memory.push_back(std::move(next));
+      next = Pair{};
+      if (memory.size() > static_cast<std::size_t>(lb.memory)) {
+        next = std::move(memory.front());
+        memory.pop_front();
+      }
     }
 
     setup.positions.swap(trial_positions);
     setup.normals.swap(trial_normals);
-    for (Eigen::Index k = 0; k < n; ++k)
-      setup.points[static_cast<std::size_t>(setup.interior[static_cast<std::size_t>(k)])] =
-          projected[static_cast<std::size_t>(k)].point;
+    setup.points.swap(trial_points);
     frames.swap(trial_frames);
     folded.swap(trial_folded);
     gradient.swap(trial_gradient);
-    stalled =
-        energies.total() - trial_energies.total() <= 1e-14 * energies.total() ? stalled + 1 : 0;
+    stalled = energies.total() - trial_energies.total() <= 0.1 * round_off(energies.total())
+                  ? stalled + 1
+                  : 0;
     energies = trial_energies;
-    q = std::move(trial_q);
-    q_norm = q.norm();
+    q.swap(trial_q);
+    q_norm = std::sqrt(dot(q, q));
     emit_frame(iteration + 1);
   }
 

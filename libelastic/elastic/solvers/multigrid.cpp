@@ -8,10 +8,12 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <mutex>
 #include <numeric>
 #include <string>
 
 #include "elastic/core/error.h"
+#include "elastic/core/huge_pages.h"
 
 namespace elastic {
 
@@ -59,11 +61,11 @@ Csr transpose(const Csr& a) {
   Csr t;
   t.rows = a.cols;
   t.cols = a.rows;
-  t.start.assign(static_cast<std::size_t>(t.rows) + 1, 0);
+  assign_huge(t.start, static_cast<std::size_t>(t.rows) + 1, std::int64_t{0});
   for (const int j : a.index) ++t.start[static_cast<std::size_t>(j) + 1];
   std::partial_sum(t.start.begin(), t.start.end(), t.start.begin());
-  t.index.resize(a.nonzeros());
-  t.value.resize(a.nonzeros());
+  assign_huge(t.index, a.nonzeros());
+  assign_huge(t.value, a.nonzeros());
   std::vector<std::int64_t> fill(t.start.begin(), t.start.end() - 1);
   // Rows of `a` in increasing order: the columns of each row of the transpose come out sorted.
   for (int i = 0; i < a.rows; ++i)
@@ -77,36 +79,54 @@ Csr transpose(const Csr& a) {
   return t;
 }
 
-// Rows computed independently (each into its own list), then concatenated in order.
-struct RowLists {
-  std::vector<std::vector<int>> index;
-  std::vector<std::vector<double>> value;
-  explicit RowLists(int rows)
-      : index(static_cast<std::size_t>(rows)), value(static_cast<std::size_t>(rows)) {}
-
-  Csr gather(int rows, int cols) {
-    Csr c;
-    c.rows = rows;
-    c.cols = cols;
-    c.start.assign(static_cast<std::size_t>(rows) + 1, 0);
-    for (int i = 0; i < rows; ++i)
-      c.start[static_cast<std::size_t>(i) + 1] =
-          c.start[static_cast<std::size_t>(i)] +
-          static_cast<std::int64_t>(index[static_cast<std::size_t>(i)].size());
-    c.index.resize(static_cast<std::size_t>(c.start.back()));
-    c.value.resize(c.index.size());
-    for_rows(rows, [&](int i) {
-      const auto row = static_cast<std::size_t>(i);
-      std::copy(index[row].begin(), index[row].end(),
-                c.index.begin() + static_cast<std::ptrdiff_t>(c.start[row]));
-      std::copy(value[row].begin(), value[row].end(),
-                c.value.begin() + static_cast<std::ptrdiff_t>(c.start[row]));
-      std::vector<int>().swap(index[row]);
-      std::vector<double>().swap(value[row]);
-    });
-    return c;
+// Builds a Csr row by row: `row(i, index, value)` appends row i's entries (columns sorted). Rows
+// are computed in fixed chunks, each into its own buffers, then concatenated in order: the result
+// does not depend on the threads, and there is one allocation per chunk, not per row.
+template <typename RowFn>
+Csr build_rows(int rows, int cols, const RowFn& row) {
+  constexpr int kChunk = 4096;
+  const int chunks = (rows + kChunk - 1) / kChunk;
+  struct Chunk {
+    std::vector<int> index;
+    std::vector<double> value;
+    std::vector<std::int64_t> count;
+  };
+  std::vector<Chunk> parts(static_cast<std::size_t>(chunks));
+  tbb::parallel_for(0, chunks, [&](int c) {
+    Chunk& part = parts[static_cast<std::size_t>(c)];
+    const int first = c * kChunk, last = std::min(rows, first + kChunk);
+    part.count.reserve(static_cast<std::size_t>(last - first));
+    for (int i = first; i < last; ++i) {
+      const std::size_t before = part.index.size();
+      row(i, part.index, part.value);
+      part.count.push_back(static_cast<std::int64_t>(part.index.size() - before));
+    }
+  });
+  Csr c;
+  c.rows = rows;
+  c.cols = cols;
+  assign_huge(c.start, static_cast<std::size_t>(rows) + 1, std::int64_t{0});
+  std::vector<std::int64_t> offset(static_cast<std::size_t>(chunks) + 1, 0);
+  for (int k = 0; k < chunks; ++k) {
+    const Chunk& part = parts[static_cast<std::size_t>(k)];
+    for (std::size_t r = 0; r < part.count.size(); ++r) {
+      const auto i = static_cast<std::size_t>(k) * kChunk + r;
+      c.start[i + 1] = c.start[i] + part.count[r];
+    }
+    offset[static_cast<std::size_t>(k) + 1] =
+        offset[static_cast<std::size_t>(k)] + static_cast<std::int64_t>(part.index.size());
   }
-};
+  assign_huge(c.index, static_cast<std::size_t>(c.start.back()));
+  assign_huge(c.value, c.index.size());
+  tbb::parallel_for(0, chunks, [&](int k) {
+    Chunk& part = parts[static_cast<std::size_t>(k)];
+    const auto at = static_cast<std::ptrdiff_t>(offset[static_cast<std::size_t>(k)]);
+    std::copy(part.index.begin(), part.index.end(), c.index.begin() + at);
+    std::copy(part.value.begin(), part.value.end(), c.value.begin() + at);
+    part = Chunk{};
+  });
+  return c;
+}
 
 // C = A B, row by row with a dense accumulator per thread. The summation order within a row is
 // fixed by the data (A's row order, then B's), so C does not depend on the threads.
@@ -121,33 +141,31 @@ Csr product(const Csr& a, const Csr& b) {
                    std::vector<int>(static_cast<std::size_t>(b.cols), -1),
                    {}};
   });
-  RowLists rows(a.rows);
-  for_rows(a.rows, [&](int i) {
-    Scratch& s = scratch.local();
-    s.used.clear();
-    for (std::int64_t e = a.start[static_cast<std::size_t>(i)];
-         e < a.start[static_cast<std::size_t>(i) + 1]; ++e) {
-      const auto k = static_cast<std::size_t>(a.index[static_cast<std::size_t>(e)]);
-      const double av = a.value[static_cast<std::size_t>(e)];
-      for (std::int64_t f = b.start[k]; f < b.start[k + 1]; ++f) {
-        const int j = b.index[static_cast<std::size_t>(f)];
-        const auto jj = static_cast<std::size_t>(j);
-        if (s.mark[jj] != i) {
-          s.mark[jj] = i;
-          s.sum[jj] = 0.0;
-          s.used.push_back(j);
+  return build_rows(
+      a.rows, b.cols, [&](int i, std::vector<int>& index, std::vector<double>& value) {
+        Scratch& s = scratch.local();
+        s.used.clear();
+        for (std::int64_t e = a.start[static_cast<std::size_t>(i)];
+             e < a.start[static_cast<std::size_t>(i) + 1]; ++e) {
+          const auto k = static_cast<std::size_t>(a.index[static_cast<std::size_t>(e)]);
+          const double av = a.value[static_cast<std::size_t>(e)];
+          for (std::int64_t f = b.start[k]; f < b.start[k + 1]; ++f) {
+            const int j = b.index[static_cast<std::size_t>(f)];
+            const auto jj = static_cast<std::size_t>(j);
+            if (s.mark[jj] != i) {
+              s.mark[jj] = i;
+              s.sum[jj] = 0.0;
+              s.used.push_back(j);
+            }
+            s.sum[jj] += av * b.value[static_cast<std::size_t>(f)];
+          }
         }
-        s.sum[jj] += av * b.value[static_cast<std::size_t>(f)];
-      }
-    }
-    std::sort(s.used.begin(), s.used.end());
-    auto& index = rows.index[static_cast<std::size_t>(i)];
-    auto& value = rows.value[static_cast<std::size_t>(i)];
-    index = s.used;
-    value.reserve(s.used.size());
-    for (const int j : s.used) value.push_back(s.sum[static_cast<std::size_t>(j)]);
-  });
-  return rows.gather(a.rows, b.cols);
+        std::sort(s.used.begin(), s.used.end());
+        for (const int j : s.used) {
+          index.push_back(j);
+          value.push_back(s.sum[static_cast<std::size_t>(j)]);
+        }
+      });
 }
 
 // (A + A^T) / 2 for A with a symmetric pattern (a Galerkin product P^T A P): removes the round-off
@@ -162,7 +180,7 @@ Csr from_eigen(const Eigen::SparseMatrix<double>& m, bool lower_only) {
   const auto n = static_cast<int>(m.rows());
   Csr a;
   a.rows = a.cols = n;
-  a.start.assign(static_cast<std::size_t>(n) + 1, 0);
+  assign_huge(a.start, static_cast<std::size_t>(n) + 1, std::int64_t{0});
   for (Eigen::Index col = 0; col < m.outerSize(); ++col)
     for (Eigen::SparseMatrix<double>::InnerIterator it(m, col); it; ++it) {
       if (!lower_only) {
@@ -174,8 +192,8 @@ Csr from_eigen(const Eigen::SparseMatrix<double>& m, bool lower_only) {
       if (it.row() != col) ++a.start[static_cast<std::size_t>(col) + 1];
     }
   std::partial_sum(a.start.begin(), a.start.end(), a.start.begin());
-  a.index.resize(static_cast<std::size_t>(a.start.back()));
-  a.value.resize(a.index.size());
+  assign_huge(a.index, static_cast<std::size_t>(a.start.back()));
+  assign_huge(a.value, a.index.size());
   std::vector<std::int64_t> fill(a.start.begin(), a.start.end() - 1);
   const auto put = [&](Eigen::Index row, Eigen::Index col, double v) {
     const auto slot = static_cast<std::size_t>(fill[static_cast<std::size_t>(row)]++);
@@ -221,22 +239,27 @@ double spectral_radius(const Csr& a, const Eigen::VectorXd& inv_diag) {
   }
   // Deterministic pseudo-random start (a multiplicative hash of the index), so that no eigenvector
   // is missed by symmetry.
-  Eigen::VectorXd x(a.rows), y(a.rows);
+  Eigen::VectorXd x, y;
+  resize_huge(x, a.rows, 1);
+  resize_huge(y, a.rows, 1);
   for (int i = 0; i < a.rows; ++i) {
     const std::uint32_t h = static_cast<std::uint32_t>(i) * 2654435761U;
     x[i] = static_cast<double>(h >> 8) / static_cast<double>(1U << 24) - 0.5;
   }
   double estimate = 0.0;
-  for (int k = 0; k < 15; ++k) {
+  for (int k = 0; k < 20; ++k) {
     sparse_times<1>(a, x.data(), y.data());  // y = A x
-    // Rayleigh quotient of the generalised problem A x = lambda D x.
-    const double xd = x.dot(x.cwiseQuotient(inv_diag));
-    if (!(xd > 0.0)) break;
-    estimate = x.dot(y) / xd;
-    x = y.cwiseProduct(inv_diag);
-    const double norm = x.norm();
-    if (!(norm > 0.0)) break;
-    x /= norm;
+    // Rayleigh quotient of the generalised problem A x = lambda D x; then x = D^-1 y / |D^-1 y|.
+    double xd = 0.0, xy = 0.0, norm = 0.0;
+    for (int i = 0; i < a.rows; ++i) {
+      xd += x[i] * x[i] / inv_diag[i];
+      xy += x[i] * y[i];
+      y[i] *= inv_diag[i];
+      norm += y[i] * y[i];
+    }
+    if (!(xd > 0.0) || !(norm > 0.0)) break;
+    estimate = xy / xd;
+    x = y / std::sqrt(norm);
   }
   return std::min(1.1 * estimate, gershgorin);
 }
@@ -299,40 +322,27 @@ std::vector<int> aggregate(const Csr& a, const Eigen::VectorXd& diag, double the
 // P = (I - omega D^-1 A) P_tent, P_tent(i, agg(i)) = 1.
 Csr smoothed_prolongation(const Csr& a, const Eigen::VectorXd& inv_diag,
                           const std::vector<int>& agg, int coarse, double omega) {
-  RowLists rows(a.rows);
-  for_rows(a.rows, [&](int i) {
-    auto& index = rows.index[static_cast<std::size_t>(i)];
-    auto& value = rows.value[static_cast<std::size_t>(i)];
-    const auto add = [&](int j, double v) {
-      const auto it = std::find(index.begin(), index.end(), j);  // a handful of aggregates per row
-      if (it == index.end()) {
-        index.push_back(j);
-        value.push_back(v);
-      } else {
-        value[static_cast<std::size_t>(it - index.begin())] += v;
-      }
-    };
-    add(agg[static_cast<std::size_t>(i)], 1.0);
-    const double scale = -omega * inv_diag[i];
-    for (std::int64_t e = a.start[static_cast<std::size_t>(i)];
-         e < a.start[static_cast<std::size_t>(i) + 1]; ++e)
-      add(agg[static_cast<std::size_t>(a.index[static_cast<std::size_t>(e)])],
-          scale * a.value[static_cast<std::size_t>(e)]);
-    // Sort the row by column.
-    std::vector<std::size_t> order(index.size());
-    std::iota(order.begin(), order.end(), std::size_t{0});
-    std::sort(order.begin(), order.end(),
-              [&](std::size_t p, std::size_t q) { return index[p] < index[q]; });
-    std::vector<int> sorted_index(index.size());
-    std::vector<double> sorted_value(index.size());
-    for (std::size_t k = 0; k < order.size(); ++k) {
-      sorted_index[k] = index[order[k]];
-      sorted_value[k] = value[order[k]];
-    }
-    index.swap(sorted_index);
-    value.swap(sorted_value);
-  });
-  return rows.gather(a.rows, coarse);
+  return build_rows(a.rows, coarse,
+                    [&](int i, std::vector<int>& index, std::vector<double>& value) {
+                      // A handful of aggregates per row: a small sorted list, merged by insertion.
+                      const std::size_t first = index.size();
+                      const auto add = [&](int j, double v) {
+                        std::size_t k = first;
+                        while (k < index.size() && index[k] < j) ++k;
+                        if (k < index.size() && index[k] == j) {
+                          value[k] += v;
+                          return;
+                        }
+                        index.insert(index.begin() + static_cast<std::ptrdiff_t>(k), j);
+                        value.insert(value.begin() + static_cast<std::ptrdiff_t>(k), v);
+                      };
+                      add(agg[static_cast<std::size_t>(i)], 1.0);
+                      const double scale = -omega * inv_diag[i];
+                      for (std::int64_t e = a.start[static_cast<std::size_t>(i)];
+                           e < a.start[static_cast<std::size_t>(i) + 1]; ++e)
+                        add(agg[static_cast<std::size_t>(a.index[static_cast<std::size_t>(e)])],
+                            scale * a.value[static_cast<std::size_t>(e)]);
+                    });
 }
 
 Eigen::SparseMatrix<double> to_eigen(const Csr& a) {
@@ -357,57 +367,136 @@ struct Multigrid::Impl {
     double lambda = 0.0;       // upper estimate of lambda_max(D^-1 A)
     Csr p, r;                  // prolongation to this level from the next, and its transpose
   };
+  // Buffers of one application, rows x 3 each: allocated once (fresh pages cost a fault each; at a
+  // million unknowns that was most of a V-cycle's time).
+  struct Work {
+    std::vector<double> b, x, r, d, t;
+  };
   MultigridOptions options;
   std::vector<Level> levels;
   Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> coarsest;
+  std::mutex mutex;  // guards `work`; a concurrent apply() allocates its own
+  std::vector<Work> work;
 
-  // Chebyshev smoothing of A x = b (see the file comment of multigrid.h), in place; `zero`: x is
-  // 0 on entry (saves the first product).
-  void smooth(const Level& level, const Block& b, Block& x, bool zero) const {
+  std::vector<Work> make_work() const {
+    std::vector<Work> w(levels.size());
+    for (std::size_t l = 0; l < levels.size(); ++l) {
+      const auto size = 3 * static_cast<std::size_t>(levels[l].a.rows);
+      for (auto* v : {&w[l].b, &w[l].x, &w[l].r, &w[l].d, &w[l].t}) assign_huge(*v, size, 0.0);
+    }
+    return w;
+  }
+
+  // Chebyshev smoothing of A x = b on level l (see the file comment of multigrid.h), in place;
+  // `zero`: x is 0 on entry (saves the first product). r is the residual b - A x throughout; the
+  // update of r, d and x is one pass over the rows.
+  void smooth(std::size_t l, const double* b, double* x, Work& w, bool zero) const {
+    const Level& level = levels[l];
     const double hi = level.lambda;  // spectral_radius: an upper estimate
     const double lo = hi / options.smoothing_range;
     const double theta = 0.5 * (hi + lo), delta = 0.5 * (hi - lo);
     const double sigma = theta / delta;
     double rho = 1.0 / sigma;
-    Block r(b.rows(), 3);
+    const double* inv = level.inv_diag.data();
+    double* r = w.r.data();
+    double* d = w.d.data();
     if (zero) {
-      r = b;
+      for_rows(level.a.rows, [&](int i) {
+        for (int c = 0; c < 3; ++c) {
+          const std::size_t k = 3 * static_cast<std::size_t>(i) + static_cast<std::size_t>(c);
+          r[k] = b[k];
+          d[k] = inv[i] * b[k] / theta;
+          x[k] = d[k];
+        }
+      });
     } else {
-      sparse_times<3>(level.a, x.data(), r.data());
-      r = b - r;
+      residual(level.a, x, b, r);
+      for_rows(level.a.rows, [&](int i) {
+        for (int c = 0; c < 3; ++c) {
+          const std::size_t k = 3 * static_cast<std::size_t>(i) + static_cast<std::size_t>(c);
+          d[k] = inv[i] * r[k] / theta;
+          x[k] += d[k];
+        }
+      });
     }
-    Block d = level.inv_diag.asDiagonal() * r / theta;
-    x += d;
-    Block ad(b.rows(), 3);
-    for (int k = 1; k < options.smoothing_degree; ++k) {
-      sparse_times<3>(level.a, d.data(), ad.data());
-      r -= ad;
+    double* t = w.t.data();
+    for (int step = 1; step < options.smoothing_degree; ++step) {
+      sparse_times<3>(level.a, d, t);
       const double rho_next = 1.0 / (2.0 * sigma - rho);
-      d = (rho_next * rho) * d + (2.0 * rho_next / delta) * (level.inv_diag.asDiagonal() * r);
+      const double keep = rho_next * rho, gain = 2.0 * rho_next / delta;
+      for_rows(level.a.rows, [&](int i) {
+        for (int c = 0; c < 3; ++c) {
+          const std::size_t k = 3 * static_cast<std::size_t>(i) + static_cast<std::size_t>(c);
+          r[k] -= t[k];
+          d[k] = keep * d[k] + gain * inv[i] * r[k];
+          x[k] += d[k];
+        }
+      });
       rho = rho_next;
-      x += d;
     }
   }
 
-  Block cycle(std::size_t l, const Block& b) const {
-    if (l + 1 == levels.size()) {
-      const Eigen::MatrixXd solution = coarsest.solve(Eigen::MatrixXd(b));
-      return solution;
-    }
+  // out = b - A x.
+  static void residual(const Csr& a, const double* x, const double* b, double* out) {
+    for_rows(a.rows, [&](int i) {
+      double sum[3] = {b[3 * i], b[3 * i + 1], b[3 * i + 2]};
+      for (std::int64_t e = a.start[static_cast<std::size_t>(i)];
+           e < a.start[static_cast<std::size_t>(i) + 1]; ++e) {
+        const double v = a.value[static_cast<std::size_t>(e)];
+        const double* xj =
+            x + 3 * static_cast<std::ptrdiff_t>(a.index[static_cast<std::size_t>(e)]);
+        for (int c = 0; c < 3; ++c) sum[c] -= v * xj[c];
+      }
+      for (int c = 0; c < 3; ++c) out[3 * i + c] = sum[c];
+    });
+  }
+
+  // x += P y.
+  static void add_product(const Csr& p, const double* y, double* x) {
+    for_rows(p.rows, [&](int i) {
+      double sum[3] = {0.0, 0.0, 0.0};
+      for (std::int64_t e = p.start[static_cast<std::size_t>(i)];
+           e < p.start[static_cast<std::size_t>(i) + 1]; ++e) {
+        const double v = p.value[static_cast<std::size_t>(e)];
+        const double* yj =
+            y + 3 * static_cast<std::ptrdiff_t>(p.index[static_cast<std::size_t>(e)]);
+        for (int c = 0; c < 3; ++c) sum[c] += v * yj[c];
+      }
+      for (int c = 0; c < 3; ++c) x[3 * i + c] += sum[c];
+    });
+  }
+
+  // x = V-cycle(b) on level l.
+  void cycle(std::size_t l, const double* b, double* x, std::vector<Work>& w) const {
     const Level& level = levels[l];
-    Block x = Block::Zero(b.rows(), 3);
-    smooth(level, b, x, true);
-    Block residual(b.rows(), 3);
-    sparse_times<3>(level.a, x.data(), residual.data());
-    residual = b - residual;
-    Block coarse_b(level.r.rows, 3);
-    sparse_times<3>(level.r, residual.data(), coarse_b.data());
-    const Block coarse_x = cycle(l + 1, coarse_b);
-    Block correction(b.rows(), 3);
-    sparse_times<3>(level.p, coarse_x.data(), correction.data());
-    x += correction;
-    smooth(level, b, x, false);
-    return x;
+    const auto n = static_cast<Eigen::Index>(level.a.rows);
+    if (l + 1 == levels.size()) {
+      const Eigen::MatrixXd rhs = Eigen::Map<const Block>(b, n, 3);
+      Eigen::Map<Block>(x, n, 3) = coarsest.solve(rhs);
+      return;
+    }
+    smooth(l, b, x, w[l], true);
+    residual(level.a, x, b, w[l].r.data());
+    sparse_times<3>(level.r, w[l].r.data(), w[l + 1].b.data());
+    cycle(l + 1, w[l + 1].b.data(), w[l + 1].x.data(), w);
+    add_product(level.p, w[l + 1].x.data(), x);
+    smooth(l, b, x, w[l], false);
+  }
+
+  // `cycles` V-cycles from x = 0 (the stationary iteration x += B (b - A x)).
+  void apply(const double* b, double* x, std::vector<Work>& w) const {
+    cycle(0, b, x, w);
+    if (options.cycles == 1) return;
+    // The level-0 buffers b and x are free at this depth: the residual and the correction.
+    double* r = w[0].b.data();
+    double* y = w[0].x.data();
+    for (int c = 1; c < options.cycles; ++c) {
+      residual(levels[0].a, x, b, r);
+      cycle(0, r, y, w);
+      for_rows(levels[0].a.rows, [&](int i) {
+        for (int k = 0; k < 3; ++k) x[3 * i + k] += y[3 * i + k];
+      });
+    }
   }
 };
 
@@ -466,15 +555,24 @@ Multigrid::Multigrid(Multigrid&&) noexcept = default;
 Multigrid& Multigrid::operator=(Multigrid&&) noexcept = default;
 
 Multigrid::Block Multigrid::apply(const Block& b) const {
+  Block x;
+  apply(b, x);
+  return x;
+}
+
+void Multigrid::apply(const Block& b, Block& x) const {
   if (b.rows() != size())
     throw InvalidInputError(kName, "right-hand side has " + std::to_string(b.rows()) +
                                        " rows, expected " + std::to_string(size()));
-  Block x = impl_->cycle(0, b);
-  for (int c = 1; c < impl_->options.cycles; ++c) {
-    const Block residual = b - multiply(x);
-    x += impl_->cycle(0, residual);
+  if (x.rows() != b.rows()) resize_huge(x, b.rows(), 3);
+  std::unique_lock<std::mutex> lock(impl_->mutex, std::try_to_lock);
+  if (lock.owns_lock()) {
+    if (impl_->work.empty()) impl_->work = impl_->make_work();
+    impl_->apply(b.data(), x.data(), impl_->work);
+  } else {
+    std::vector<Impl::Work> own = impl_->make_work();
+    impl_->apply(b.data(), x.data(), own);
   }
-  return x;
 }
 
 Eigen::VectorXd Multigrid::apply(const Eigen::VectorXd& b) const {

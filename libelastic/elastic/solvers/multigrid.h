@@ -73,6 +73,9 @@ class Multigrid {
 
   /// x = B b: `cycles` V-cycles from x = 0, for three right-hand sides at once.
   Block apply(const Block& b) const;
+  /// The same into `x` (resized when needed). The cycle's buffers are allocated once per object;
+  /// concurrent calls on one object are safe (a second caller gets buffers of its own).
+  void apply(const Block& b, Block& x) const;
   /// The same for one right-hand side.
   Eigen::VectorXd apply(const Eigen::VectorXd& b) const;
 

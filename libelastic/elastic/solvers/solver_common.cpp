@@ -12,6 +12,7 @@
 #include <utility>
 
 #include "elastic/core/error.h"
+#include "elastic/core/huge_pages.h"
 
 namespace elastic::solver_detail {
 
@@ -428,15 +429,31 @@ LaplacianInverse::LaplacianInverse(const Eigen::SparseMatrix<double>& laplacian,
   }
 }
 
-Eigen::VectorXd LaplacianInverse::solve3(const Eigen::VectorXd& b) const {
-  if (direct_) return direct_->solve3(b);
+void LaplacianInverse::solve3(const Eigen::VectorXd& b, Eigen::VectorXd& x) const {
+  if (direct_) {
+    x = direct_->solve3(b);
+    return;
+  }
   const Eigen::Index n = multigrid_->size();
-  Multigrid::Block block(n, 3);
-  for (int c = 0; c < 3; ++c) block.col(c) = b.segment(c * n, n);
-  const Multigrid::Block x = multigrid_->apply(block);
-  Eigen::VectorXd r(3 * n);
-  for (int c = 0; c < 3; ++c) r.segment(c * n, n) = x.col(c);
-  return r;
+  if (block_b_.rows() != n) {
+    resize_huge(block_b_, n, 3);
+    resize_huge(block_x_, n, 3);
+  }
+  if (x.size() != 3 * n) resize_huge(x, 3 * n, 1);
+  // Column blocks <-> rows of three, in parallel chunks.
+  const auto rows = [&](const auto& body) {
+    tbb::parallel_for(tbb::blocked_range<Eigen::Index>(0, n, 16384),
+                      [&](const tbb::blocked_range<Eigen::Index>& r) {
+                        for (Eigen::Index i = r.begin(); i != r.end(); ++i) body(i);
+                      });
+  };
+  rows([&](Eigen::Index i) {
+    for (int c = 0; c < 3; ++c) block_b_(i, c) = b[c * n + i];
+  });
+  multigrid_->apply(block_b_, block_x_);
+  rows([&](Eigen::Index i) {
+    for (int c = 0; c < 3; ++c) x[c * n + i] = block_x_(i, c);
+  });
 }
 
 double boundary_residual(const RelaxationProblem& problem, const Eigen::Matrix3Xd& positions) {

@@ -97,8 +97,9 @@ class LaplacianInverse {
   /// interior particles (the direct factorisation's ordering).
   LaplacianInverse(const Eigen::SparseMatrix<double>& laplacian,
                    const Eigen::Matrix3Xd& coordinates, const LbfgsOptions& options);
-  /// The operator on the three n-blocks of b (x, y, z).
-  Eigen::VectorXd solve3(const Eigen::VectorXd& b) const;
+  /// x = the operator on the three n-blocks of b (x, y, z); x is resized when needed. Not for
+  /// concurrent calls (the multigrid path reuses conversion buffers).
+  void solve3(const Eigen::VectorXd& b, Eigen::VectorXd& x) const;
   /// Direct or Multigrid.
   Preconditioner kind() const { return kind_; }
 
@@ -106,6 +107,7 @@ class LaplacianInverse {
   Preconditioner kind_ = Preconditioner::Direct;
   std::unique_ptr<LaplacianFactor> direct_;
   std::unique_ptr<Multigrid> multigrid_;
+  mutable Multigrid::Block block_b_, block_x_;  // row-major copies of b and x for the V-cycle
 };
 
 /// The parameter-space frame of a surface point: first and second derivatives of the limit
