@@ -12,6 +12,7 @@
 
 #include "elastic/core/error.h"
 #include "elastic/projection/closest_point.h"
+#include "elastic/solvers/solver_common.h"
 #include "elastic/surface/limit_surface.h"
 #include "solvers/solver_fixtures.h"
 
@@ -323,6 +324,51 @@ TEST(Relaxation, AllBoundaryAndInvalidInput) {
   EXPECT_THROW(relax(problem), InvalidInputError);
   EXPECT_EQ(parse_solver_kind("faithful"), SolverKind::Faithful);
   EXPECT_THROW(parse_solver_kind("slow"), InvalidInputError);
+}
+
+}  // namespace
+}  // namespace elastic
+
+namespace elastic {
+namespace {
+
+TEST(Relaxation, InteriorLaplacianIsTheQuadraticFormOfTheSprings) {
+  // L is the Hessian of sum C |x_i - x_j|^2 + sum C_a |x_i - (x_a + x_b)/2|^2 over the interior
+  // particles (boundary ones fixed at 0): v^T L v must equal twice that sum for any v, and L must
+  // be symmetric with positive diagonal. Checked on random v against the springs themselves.
+  const ParticleGrid grid = test::make_quad_grid(9, 7, 0.1, {-0.45, -0.35});
+  const Target target(test::make_plane_mesh(2, 1.0, Eigen::Isometry3d::Identity()));
+  const RelaxationProblem problem = make_problem(grid, target, test::grid_positions(grid));
+  RelaxationOptions options;
+  options.stiffness = 1.7;
+  options.angular_stiffness = 0.6;
+  const solver_detail::RelaxationSetup setup(problem, options);
+  const Eigen::SparseMatrix<double> lower = solver_detail::interior_laplacian(setup, options);
+  ASSERT_EQ(lower.rows(), setup.num_free());
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  for (int trial = 0; trial < 3; ++trial) {
+    Eigen::VectorXd v(setup.num_free());
+    for (Eigen::Index k = 0; k < v.size(); ++k) v[k] = u(rng);
+    const auto value = [&](int p) {
+      const int k = setup.interior_index[static_cast<std::size_t>(p)];
+      return k < 0 ? 0.0 : v[k];
+    };
+    double form = 0.0;
+    for (const Spring& s : grid.springs)
+      form += options.stiffness * std::pow(value(s.i) - value(s.j), 2);
+    for (const AngularSpring& s : grid.angular_springs)
+      form += options.angular_stiffness * std::pow(value(s.i) - 0.5 * (value(s.a) + value(s.b)), 2);
+    // v^T L v from the lower triangle: diagonal once, off-diagonal entries twice.
+    double quadratic = 0.0;
+    for (Eigen::Index c = 0; c < lower.outerSize(); ++c)
+      for (Eigen::SparseMatrix<double>::InnerIterator it(lower, c); it; ++it)
+        quadratic += (it.row() == it.col() ? 1.0 : 2.0) * it.value() * v[it.row()] * v[it.col()];
+    EXPECT_NEAR(quadratic, 2.0 * form, 1e-12 * form);
+  }
+  for (Eigen::Index k = 0; k < lower.outerSize(); ++k)
+    for (Eigen::SparseMatrix<double>::InnerIterator it(lower, k); it; ++it)
+      EXPECT_GE(it.row(), it.col()) << "only the lower triangle is stored";
 }
 
 }  // namespace

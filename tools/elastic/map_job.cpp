@@ -70,6 +70,9 @@ void add_map_flags(CLI::App& sub, MapJob& a) {
   sub.add_option("--particles", a.particles, "Number of particles (within 5%)");
   sub.add_option("--solver", a.solver, "lbfgs (fast) or explicit (the paper's integrator)")
       ->check(CLI::IsMember({"lbfgs", "explicit"}));
+  sub.add_option("--preconditioner", a.preconditioner,
+                 "H0 of lbfgs: multigrid (V-cycle, default) or direct (exact factorisation)")
+      ->check(CLI::IsMember({"multigrid", "direct"}));
   sub.add_option("--rest-scale", a.rest_scale, "boundary | area | none")
       ->check(CLI::IsMember({"boundary", "area", "none"}));
   sub.add_option("--scheme", a.scheme, "Subdivision scheme for both meshes")
@@ -92,6 +95,8 @@ MapOptions make_map_options(const MapJob& job, const ProgressCallback& progress)
   options.sampling.sampling.seed = job.seed;
   options.rest_scale = parse_rest_scale(job.rest_scale, "--rest-scale");
   options.relaxation.solver = job.solver == "explicit" ? SolverKind::Faithful : SolverKind::Fast;
+  options.relaxation.lbfgs.preconditioner =
+      parse_preconditioner(job.preconditioner, "--preconditioner");
   options.relaxation.threads = job.threads;
   options.relaxation.max_iterations = job.max_iterations;
   options.subdivisions = job.subdivide;

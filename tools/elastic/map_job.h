@@ -24,24 +24,25 @@
 namespace elastic::cli {
 
 struct MapJob {
-  std::string source;                      ///< --source MESH
-  std::string source_image;                ///< --source-image IMAGE (a plane carrying the image)
-  double image_width = 2.0;                ///< --image-width: physical width of the image's plane
-  std::string source_region = "boundary";  ///< --source-region SPEC
-  std::string source_anchor;               ///< --source-anchor X,Y,Z
-  std::string target;                      ///< --target MESH (required)
-  std::string target_region = "boundary";  ///< --target-region SPEC
-  std::string target_anchor;               ///< --target-anchor X,Y,Z
-  long particles = 1000;                   ///< --particles N
-  std::string solver = "lbfgs";            ///< --solver lbfgs|explicit
-  std::string rest_scale = "boundary";     ///< --rest-scale boundary|area|none
-  std::string scheme = "auto";             ///< --scheme auto|loop|catmull-clark
-  int subdivide = 0;                       ///< --subdivide K: refinement levels after the map
-  int threads = 0;                         ///< --threads N (0: all)
-  unsigned long seed = 0;                  ///< --seed S
-  long max_iterations = 0;                 ///< --max-iterations (0: the solver's default)
-  std::string report;                      ///< --report FILE
-  bool quiet = false;                      ///< --quiet
+  std::string source;                        ///< --source MESH
+  std::string source_image;                  ///< --source-image IMAGE (a plane carrying the image)
+  double image_width = 2.0;                  ///< --image-width: physical width of the image's plane
+  std::string source_region = "boundary";    ///< --source-region SPEC
+  std::string source_anchor;                 ///< --source-anchor X,Y,Z
+  std::string target;                        ///< --target MESH (required)
+  std::string target_region = "boundary";    ///< --target-region SPEC
+  std::string target_anchor;                 ///< --target-anchor X,Y,Z
+  long particles = 1000;                     ///< --particles N
+  std::string solver = "lbfgs";              ///< --solver lbfgs|explicit
+  std::string preconditioner = "multigrid";  ///< --preconditioner multigrid|direct (lbfgs)
+  std::string rest_scale = "boundary";       ///< --rest-scale boundary|area|none
+  std::string scheme = "auto";               ///< --scheme auto|loop|catmull-clark
+  int subdivide = 0;                         ///< --subdivide K: refinement levels after the map
+  int threads = 0;                           ///< --threads N (0: all)
+  unsigned long seed = 0;                    ///< --seed S
+  long max_iterations = 0;                   ///< --max-iterations (0: the solver's default)
+  std::string report;                        ///< --report FILE
+  bool quiet = false;                        ///< --quiet
 };
 
 /// Adds the MapJob flags to a subcommand (--report and --quiet included).

@@ -38,9 +38,13 @@ constexpr int kMaxStalled = 20;
 // iteration.
 constexpr Eigen::Index kChunk = 16384;
 
+// Per-particle work that evaluates the surface (retraction, frames): microseconds per item, so
+// small chunks still pay for themselves.
+constexpr Eigen::Index kSurfaceChunk = 256;
+
 template <typename Body>
-void for_chunks(Eigen::Index n, const Body& body) {
-  tbb::parallel_for(tbb::blocked_range<Eigen::Index>(0, n, kChunk),
+void for_chunks(Eigen::Index n, const Body& body, Eigen::Index chunk = kChunk) {
+  tbb::parallel_for(tbb::blocked_range<Eigen::Index>(0, n, chunk),
                     [&](const tbb::blocked_range<Eigen::Index>& r) {
                       for (Eigen::Index i = r.begin(); i != r.end(); ++i) body(i);
                     });
@@ -205,13 +209,17 @@ RelaxationResult relax_lbfgs(const RelaxationProblem& problem, const RelaxationO
   Pair next;        // storage of the next (s, y) pair; the oldest pair's once the memory is full
   int stalled = 0;  // consecutive steps that changed the energy by less than its round-off
   // Tangent frames (du, dv) of the interior particles at their current and trial surface points.
-  std::vector<solver_detail::TangentFrame> frames(static_cast<std::size_t>(n)),
-      trial_frames(frames.size());
-  for_chunks(n, [&](Eigen::Index k) {
-    frames[static_cast<std::size_t>(k)] = solver_detail::tangent_frame(
-        setup.target.surface(),
-        setup.points[static_cast<std::size_t>(setup.interior[static_cast<std::size_t>(k)])]);
-  });
+  std::vector<solver_detail::TangentFrame> frames, trial_frames;
+  assign_huge(frames, static_cast<std::size_t>(n));
+  assign_huge(trial_frames, static_cast<std::size_t>(n));
+  for_chunks(
+      n,
+      [&](Eigen::Index k) {
+        frames[static_cast<std::size_t>(k)] = solver_detail::tangent_frame(
+            setup.target.surface(),
+            setup.points[static_cast<std::size_t>(setup.interior[static_cast<std::size_t>(k)])]);
+      },
+      kSurfaceChunk);
   // The trial state. Boundary particles never move, so their columns are copied once here and stay
   // equal in both buffers through the swaps; the retraction writes the interior columns.
   Eigen::Matrix3Xd trial_positions, trial_normals, trial_gradient;
@@ -220,7 +228,10 @@ RelaxationResult relax_lbfgs(const RelaxationProblem& problem, const RelaxationO
   resize_huge(trial_gradient, 3, setup.num_particles);
   trial_positions = setup.positions;
   trial_normals = setup.normals;
-  std::vector<SurfacePoint> trial_points = setup.points;
+  std::vector<SurfacePoint> trial_points;
+  trial_points.reserve(setup.points.size());
+  advise_huge_pages(trial_points.data(), setup.points.size() * sizeof(SurfacePoint));
+  trial_points.assign(setup.points.begin(), setup.points.end());
   std::vector<char> trial_folded;
 
   const auto emit_frame = [&](long iteration) {
@@ -306,32 +317,35 @@ RelaxationResult relax_lbfgs(const RelaxationProblem& problem, const RelaxationO
     // Backtracking line search along the retraction (solver_detail::parametric_retraction, the
     // magnet where it declines).
     const auto retract = [&](double alpha) {
-      for_chunks(n, [&](Eigen::Index k) {
-        const auto kk = static_cast<std::size_t>(k);
-        const auto p = static_cast<std::size_t>(setup.interior[kk]);
-        const auto col = static_cast<Eigen::Index>(p);
-        const Eigen::Vector3d step = alpha * layout.at(direction, k);
-        solver_detail::TangentFrame& frame = trial_frames[kk];
-        if (step.isZero(0.0)) {  // blocked (or converged) particle: exactly where it is
-          trial_points[p] = setup.points[p];
-          trial_positions.col(col) = setup.positions.col(col);
-          trial_normals.col(col) = setup.normals.col(col);
-          frame = frames[kk];
-          return;
-        }
-        ClosestPoint out;
-        if (!solver_detail::parametric_retraction(setup.target.surface(), setup.points[p],
-                                                  setup.positions.col(col), frames[kk], step, out,
-                                                  frame)) {
-          // Magnet fallback: the closest point of x + alpha p, warm started.
-          out = setup.target.closest(Eigen::Vector3d(setup.positions.col(col) + step),
-                                     setup.points[p]);
-          frame = solver_detail::tangent_frame(setup.target.surface(), out.point);
-        }
-        trial_points[p] = out.point;
-        trial_positions.col(col) = out.position;
-        trial_normals.col(col) = out.normal;
-      });
+      for_chunks(
+          n,
+          [&](Eigen::Index k) {
+            const auto kk = static_cast<std::size_t>(k);
+            const auto p = static_cast<std::size_t>(setup.interior[kk]);
+            const auto col = static_cast<Eigen::Index>(p);
+            const Eigen::Vector3d step = alpha * layout.at(direction, k);
+            solver_detail::TangentFrame& frame = trial_frames[kk];
+            if (step.isZero(0.0)) {  // blocked (or converged) particle: exactly where it is
+              trial_points[p] = setup.points[p];
+              trial_positions.col(col) = setup.positions.col(col);
+              trial_normals.col(col) = setup.normals.col(col);
+              frame = frames[kk];
+              return;
+            }
+            ClosestPoint out;
+            if (!solver_detail::parametric_retraction(setup.target.surface(), setup.points[p],
+                                                      setup.positions.col(col), frames[kk], step,
+                                                      out, frame)) {
+              // Magnet fallback: the closest point of x + alpha p, warm started.
+              out = setup.target.closest(Eigen::Vector3d(setup.positions.col(col) + step),
+                                         setup.points[p]);
+              frame = solver_detail::tangent_frame(setup.target.surface(), out.point);
+            }
+            trial_points[p] = out.point;
+            trial_positions.col(col) = out.position;
+            trial_normals.col(col) = out.normal;
+          },
+          kSurfaceChunk);
     };
     bool accepted = false;
     bool trial_q_ready = false;

@@ -23,8 +23,6 @@ SolverKind parse_solver_kind(std::string_view text, std::string_view input) {
 
 std::string_view to_string(Preconditioner kind) {
   switch (kind) {
-    case Preconditioner::Auto:
-      return "auto";
     case Preconditioner::Direct:
       return "direct";
     case Preconditioner::Multigrid:
@@ -34,11 +32,10 @@ std::string_view to_string(Preconditioner kind) {
 }
 
 Preconditioner parse_preconditioner(std::string_view text, std::string_view input) {
-  if (text == "auto") return Preconditioner::Auto;
   if (text == "direct") return Preconditioner::Direct;
   if (text == "multigrid") return Preconditioner::Multigrid;
   throw InvalidInputError(std::string(input), "unknown preconditioner '" + std::string(text) +
-                                                  "' (expected auto, direct or multigrid)");
+                                                  "' (expected multigrid or direct)");
 }
 
 std::string_view to_string(StopReason reason) {

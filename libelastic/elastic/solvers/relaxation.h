@@ -90,13 +90,14 @@ struct ExplicitOptions {
 /// How the L-BFGS solver applies its initial inverse Hessian H0 ~ L^-1 (L the interior spring
 /// Laplacian, solver_common.h).
 enum class Preconditioner {
-  Auto,      ///< Direct up to LbfgsOptions::direct_limit interior particles, Multigrid above
-  Direct,    ///< exact: sparse LDL^T in nested-dissection order, factorised once (O(n^1.5))
-  Multigrid  ///< one algebraic-multigrid V-cycle (multigrid.h): O(n) set-up and application
+  Multigrid,  ///< one algebraic-multigrid V-cycle (multigrid.h): O(n) set-up and application; on
+              ///< grids of at most MultigridOptions::coarsest_size interior particles it is the
+              ///< exact factorisation itself (one level)
+  Direct      ///< exact: sparse LDL^T in nested-dissection order, factorised once (O(n^1.5))
 };
-/// "auto", "direct", "multigrid".
+/// "multigrid", "direct".
 std::string_view to_string(Preconditioner kind);
-/// Parses "auto", "direct" or "multigrid". \throws InvalidInputError naming `input` otherwise.
+/// Parses "multigrid" or "direct". \throws InvalidInputError naming `input` otherwise.
 Preconditioner parse_preconditioner(std::string_view text,
                                     std::string_view input = "preconditioner");
 
@@ -105,10 +106,10 @@ struct LbfgsOptions {
   int memory = 8;           ///< number of (s, y) pairs kept
   double armijo = 1e-4;     ///< sufficient-decrease constant c1 of the Armijo condition
   int max_backtracks = 40;  ///< step halvings per line search before giving up
-  Preconditioner preconditioner = Preconditioner::Auto;  ///< how H0 = L^-1 is applied
-  /// Auto chooses Direct up to this many interior particles (below it the factorisation is cheaper
-  /// than the V-cycles: docs/solvers.md has the measurements).
-  int direct_limit = 30000;
+  /// How H0 = L^-1 is applied. The V-cycle is the default: it was as fast or faster than the
+  /// exact factorisation at every size measured, 405 to 100,000 particles (docs/solvers.md), and
+  /// the only one that scales to millions.
+  Preconditioner preconditioner = Preconditioner::Multigrid;
   MultigridOptions multigrid;  ///< the V-cycle's parameters (Preconditioner::Multigrid)
 };
 
@@ -151,8 +152,8 @@ struct RelaxationResult {
   long evaluations = 0;  ///< energy evaluations (L-BFGS line-search trials included)
   bool converged = false;
   StopReason reason = StopReason::MaxIterations;
-  /// L-BFGS: the H0 actually used (Direct or Multigrid; Auto never appears here).
-  Preconditioner preconditioner = Preconditioner::Auto;
+  /// L-BFGS: the H0 used.
+  Preconditioner preconditioner = Preconditioner::Multigrid;
   double setup_seconds = 0.0;   ///< incidence tables, Laplacian factorisation, normals
   double solve_seconds = 0.0;   ///< the iterations
   double initial_energy = 0.0;  ///< E_len + E_ang at the start

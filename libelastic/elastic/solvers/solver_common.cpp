@@ -72,12 +72,16 @@ RelaxationSetup::RelaxationSetup(const RelaxationProblem& problem, const Relaxat
     interior.push_back(static_cast<int>(p));
   }
 
+  // Fresh buffers advised before they are written (core/huge_pages.h).
+  resize_huge(positions, 3, num_particles);
   positions = problem.initial_positions;
-  points = problem.initial_points;
+  points.reserve(P);
+  advise_huge_pages(points.data(), P * sizeof(SurfacePoint));
+  points.assign(problem.initial_points.begin(), problem.initial_points.end());
 
   // Unit normals du x dv / |du x dv| at the given surface points (the fold test and the tangent
   // projection need them for every particle; interior ones are refreshed by each retraction).
-  normals.resize(3, num_particles);
+  resize_huge(normals, 3, num_particles);
   const LimitSurface& surface = target.surface();
   tbb::parallel_for(tbb::blocked_range<int>(0, num_particles, 256),
                     [&](const tbb::blocked_range<int>& range) {
@@ -119,43 +123,106 @@ double tangential_norm(const RelaxationSetup& setup, const Eigen::Matrix3Xd& gra
 Eigen::SparseMatrix<double> interior_laplacian(const RelaxationSetup& setup,
                                                const RelaxationOptions& options) {
   const int n = setup.num_free();
-  // Only the lower triangle is stored (what the LDL^T factorisation reads); the diagonal is summed
-  // densely first, which keeps the triplet list (and its sort) small.
+  // Normal spring: C (|d| - k)^2 has Hessian 2C d d^T/|d|^2 at rest; the isotropic 2C I per
+  // coordinate. Angular spring: e = x_i - (x_a + x_b)/2 = v . (x_i, x_a, x_b), Gram matrix
+  // 2 C_a v v^T with v = (1, -1/2, -1/2): diagonal (2, 1/2, 1/2) C_a, (i,a) and (i,b) -C_a,
+  // (a,b) +C_a/2. `visit` hands every contribution (particle, particle, value) to `emit`.
+  const double w = 2.0 * options.stiffness, ca = options.angular_stiffness;
+  const auto visit = [&](const auto& emit) {
+    for (const Spring& sp : setup.grid.springs) {
+      emit(sp.i, sp.i, w);
+      emit(sp.j, sp.j, w);
+      emit(sp.i, sp.j, -w);
+    }
+    for (const AngularSpring& sp : setup.grid.angular_springs) {
+      emit(sp.i, sp.i, 2.0 * ca);
+      emit(sp.a, sp.a, 0.5 * ca);
+      emit(sp.b, sp.b, 0.5 * ca);
+      emit(sp.i, sp.a, -ca);
+      emit(sp.i, sp.b, -ca);
+      emit(sp.a, sp.b, 0.5 * ca);
+    }
+  };
+  // Only the lower triangle is stored (what the LDL^T factorisation reads), column by column:
+  // entry (max, min) goes to column min. Counted, scattered into per-column buckets, then each
+  // column sorted and its duplicates summed, in parallel (a triplet list and Eigen's
+  // setFromTriplets took 2 s at a million particles).
+  const auto interior = [&](int p) { return setup.interior_index[static_cast<std::size_t>(p)]; };
+  std::vector<std::int64_t> start;
+  assign_huge(start, static_cast<std::size_t>(n) + 2, std::int64_t{0});
   Eigen::VectorXd diagonal = Eigen::VectorXd::Zero(n);
-  std::vector<Eigen::Triplet<double>> triplets;
-  triplets.reserve(setup.grid.springs.size() + 3 * setup.grid.angular_springs.size() +
-                   static_cast<std::size_t>(n));
-  const auto add = [&](int p, int q, double value) {
-    const int a = setup.interior_index[static_cast<std::size_t>(p)];
-    const int b = setup.interior_index[static_cast<std::size_t>(q)];
+  visit([&](int p, int q, double value) {
+    const int a = interior(p), b = interior(q);
     if (a < 0 || b < 0) return;
     if (a == b)
       diagonal[a] += value;
     else
-      triplets.emplace_back(std::max(a, b), std::min(a, b), value);
-  };
-  // Normal spring: C (|d| - k)^2 has Hessian 2C d d^T/|d|^2 at rest; the isotropic 2C I per
-  // coordinate.
-  const double w = 2.0 * options.stiffness;
-  for (const Spring& s : setup.grid.springs) {
-    add(s.i, s.i, w);
-    add(s.j, s.j, w);
-    add(s.i, s.j, -w);
+      ++start[static_cast<std::size_t>(std::min(a, b)) + 2];
+  });
+  // start[c + 2] counts column c's off-diagonal entries; one more slot per column for the
+  // diagonal, stored first.
+  for (int c = 0; c < n; ++c) start[static_cast<std::size_t>(c) + 2] += 1;
+  for (std::size_t c = 2; c < start.size(); ++c) start[c] += start[c - 1];
+  std::vector<int> rows;
+  std::vector<double> values;
+  assign_huge(rows, static_cast<std::size_t>(start.back()));
+  assign_huge(values, rows.size());
+  // start[c + 1] is now the fill position of column c.
+  for (int c = 0; c < n; ++c) {
+    const auto slot = static_cast<std::size_t>(start[static_cast<std::size_t>(c) + 1]++);
+    rows[slot] = c;
+    values[slot] = diagonal[c];
   }
-  // Angular spring: e = x_i - (x_a + x_b)/2 = v . (x_i, x_a, x_b), Gram matrix 2 C_a v v^T with
-  // v = (1, -1/2, -1/2): diagonal (2, 1/2, 1/2) C_a, (i,a) and (i,b) -C_a, (a,b) +C_a/2.
-  const double ca = options.angular_stiffness;
-  for (const AngularSpring& s : setup.grid.angular_springs) {
-    add(s.i, s.i, 2.0 * ca);
-    add(s.a, s.a, 0.5 * ca);
-    add(s.b, s.b, 0.5 * ca);
-    add(s.i, s.a, -ca);
-    add(s.i, s.b, -ca);
-    add(s.a, s.b, 0.5 * ca);
-  }
-  for (int k = 0; k < n; ++k) triplets.emplace_back(k, k, diagonal[k]);
+  visit([&](int p, int q, double value) {
+    const int a = interior(p), b = interior(q);
+    if (a < 0 || b < 0 || a == b) return;
+    const auto slot =
+        static_cast<std::size_t>(start[static_cast<std::size_t>(std::min(a, b)) + 1]++);
+    rows[slot] = std::max(a, b);
+    values[slot] = value;
+  });
+  // Column c spans [start[c], start[c + 1]). Sort by row (a dozen entries: insertion sort) and sum
+  // duplicates in place; `kept` receives each column's length.
+  std::vector<int> kept(static_cast<std::size_t>(n));
+  tbb::parallel_for(tbb::blocked_range<int>(0, n, 4096), [&](const tbb::blocked_range<int>& r) {
+    for (int c = r.begin(); c != r.end(); ++c) {
+      const auto first = static_cast<std::size_t>(start[static_cast<std::size_t>(c)]);
+      const auto last = static_cast<std::size_t>(start[static_cast<std::size_t>(c) + 1]);
+      for (std::size_t i = first + 1; i < last; ++i)
+        for (std::size_t j = i; j > first && rows[j - 1] > rows[j]; --j) {
+          std::swap(rows[j - 1], rows[j]);
+          std::swap(values[j - 1], values[j]);
+        }
+      std::size_t out = first;
+      for (std::size_t i = first + 1; i < last; ++i) {
+        if (rows[i] == rows[out]) {
+          values[out] += values[i];
+        } else {
+          ++out;
+          rows[out] = rows[i];
+          values[out] = values[i];
+        }
+      }
+      kept[static_cast<std::size_t>(c)] = static_cast<int>(out + 1 - first);
+    }
+  });
   Eigen::SparseMatrix<double> laplacian(n, n);
-  laplacian.setFromTriplets(triplets.begin(), triplets.end());
+  std::int64_t nonzeros = 0;
+  for (const int k : kept) nonzeros += k;
+  laplacian.resizeNonZeros(static_cast<Eigen::Index>(nonzeros));
+  int* outer = laplacian.outerIndexPtr();
+  outer[0] = 0;
+  for (int c = 0; c < n; ++c) outer[c + 1] = outer[c] + kept[static_cast<std::size_t>(c)];
+  tbb::parallel_for(tbb::blocked_range<int>(0, n, 4096), [&](const tbb::blocked_range<int>& r) {
+    for (int c = r.begin(); c != r.end(); ++c) {
+      const auto from = static_cast<std::ptrdiff_t>(start[static_cast<std::size_t>(c)]);
+      const auto count = static_cast<std::ptrdiff_t>(kept[static_cast<std::size_t>(c)]);
+      std::copy(rows.begin() + from, rows.begin() + from + count,
+                laplacian.innerIndexPtr() + outer[c]);
+      std::copy(values.begin() + from, values.begin() + from + count,
+                laplacian.valuePtr() + outer[c]);
+    }
+  });
   return laplacian;
 }
 
@@ -409,11 +476,7 @@ bool parametric_retraction(const LimitSurface& surface, const SurfacePoint& from
 LaplacianInverse::LaplacianInverse(const Eigen::SparseMatrix<double>& laplacian,
                                    const Eigen::Matrix3Xd& coordinates,
                                    const LbfgsOptions& options) {
-  if (options.direct_limit < 0) throw InvalidInputError(kName, "direct_limit must be >= 0");
   kind_ = options.preconditioner;
-  if (kind_ == Preconditioner::Auto)
-    kind_ = laplacian.rows() <= options.direct_limit ? Preconditioner::Direct
-                                                     : Preconditioner::Multigrid;
   if (kind_ == Preconditioner::Direct) {
     direct_ = std::make_unique<LaplacianFactor>(laplacian, coordinates);
     return;

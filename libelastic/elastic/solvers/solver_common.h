@@ -100,11 +100,10 @@ class LaplacianInverse {
   /// x = the operator on the three n-blocks of b (x, y, z); x is resized when needed. Not for
   /// concurrent calls (the multigrid path reuses conversion buffers).
   void solve3(const Eigen::VectorXd& b, Eigen::VectorXd& x) const;
-  /// Direct or Multigrid.
   Preconditioner kind() const { return kind_; }
 
  private:
-  Preconditioner kind_ = Preconditioner::Direct;
+  Preconditioner kind_ = Preconditioner::Multigrid;
   std::unique_ptr<LaplacianFactor> direct_;
   std::unique_ptr<Multigrid> multigrid_;
   mutable Multigrid::Block block_b_, block_x_;  // row-major copies of b and x for the V-cycle
