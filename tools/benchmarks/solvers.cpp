@@ -65,9 +65,11 @@ const PlaneToCap& plane_to_cap(long particles) {
   return *entry;
 }
 
-void run_plane_to_cap(benchmark::State& state, Preconditioner preconditioner) {
+void run_plane_to_cap(benchmark::State& state, Preconditioner preconditioner,
+                      SolverKind solver = SolverKind::Fast) {
   const PlaneToCap& setup = plane_to_cap(state.range(0));
-  RelaxationOptions options;  // fast mode, relative tangential gradient 1e-6
+  RelaxationOptions options;  // relative tangential gradient 1e-6
+  options.solver = solver;
   options.lbfgs.preconditioner = preconditioner;
   RelaxationResult result;
   for (auto _ : state) {
@@ -93,6 +95,10 @@ void BM_PlaneToCapFast(benchmark::State& state) {
 // Either preconditioner explicitly, to compare them.
 void BM_PlaneToCapDirect(benchmark::State& state) {
   run_plane_to_cap(state, Preconditioner::Direct);
+}
+// The paper's explicit integrator (faithful mode) on the same problems, for comparison.
+void BM_PlaneToCapFaithful(benchmark::State& state) {
+  run_plane_to_cap(state, Preconditioner::Multigrid, SolverKind::Faithful);
 }
 void BM_PlaneToCapMultigrid(benchmark::State& state) {
   run_plane_to_cap(state, Preconditioner::Multigrid);
@@ -123,6 +129,13 @@ BENCHMARK(BM_PlaneToCapMultigrid)
     ->Arg(20000)
     ->Arg(50000)
     ->Arg(100000)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK(BM_PlaneToCapFaithful)
+    ->Name("PlaneToCapFaithful")
+    ->Arg(409)
+    ->Arg(2000)
+    ->Arg(5775)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 // One million particles: minutes of set-up (sampling, naive map) before the first timed run; run
