@@ -11,8 +11,9 @@
 /// 2. Direction p = -H q by the L-BFGS two-loop recursion over the last `memory` pairs (s, y)
 ///    (s: change of the positions, y: change of P g), with the initial inverse Hessian H0 = L^-1,
 ///    L the interior spring Laplacian (solver_common.h: 2C per spring plus the angular springs'
-///    Gram matrices), ordered by geometric nested dissection, factorised once with a sparse LDL^T
-///    and applied to the x, y and z coordinates. The first step is therefore the Laplacian solve
+///    Gram matrices), applied to the x, y and z coordinates by one algebraic-multigrid V-cycle
+///    (multigrid.h, default) or an exact sparse LDL^T in nested-dissection order
+///    (LbfgsOptions::preconditioner). The first step is therefore (about) the Laplacian solve
 ///    -L^-1 P g, a Newton step for the springs linearised at rest.
 /// 3. p is projected on the tangent planes again. If it is not a descent direction (P g . p >= 0)
 ///    the memory is cleared and p = -P L^-1 P g is used.
@@ -20,8 +21,11 @@
 ///    particle's ptex face, delta = (J^T J)^-1 J^T t with J = [du dv], corrected to second order
 ///    by the surface's second derivatives, walked across ptex edges, and evaluated: one patch
 ///    evaluation per particle. Like the magnet (closest point of x + t, §4.4) it moves the particle
-///    by t + O(|t|^3) along the surface; where the parameterisation is degenerate or the walk
-///    reaches the surface boundary the magnet itself is used (warm started).
+///    by t + O(|t|^3) along the surface. A landing that misses x + t tangentially by more than
+///    1e-3 |t| (after crossing an irregular ptex edge) is corrected to the foot of x + t by
+///    Gauss-Newton steps; where the parameterisation is degenerate, the walk reaches the surface
+///    boundary or the correction fails, the magnet itself is used (warm started). See
+///    solver_detail::parametric_retraction.
 /// 5. Backtracking line search from alpha = 1. A trial that folds a face corner that was not folded
 ///    (SpringSystem::folded_corners with the new normals) is never taken. The first 4 such trials
 ///    halve alpha; after that the free particles of the newly folded corners are *held*: they keep
@@ -30,8 +34,10 @@
 ///    and p recomputed as -P L^-1 P g on the new subspace), retrying the same alpha, up to 8
 ///    rounds, after which alpha is halved again. A trial is also rejected (alpha halved) when the
 ///    energy is not finite or the Armijo condition E(alpha) <= E + c1 alpha (P g . p) fails.
-///    Close to the minimum the energy change can drop below its round-off; a trial within
-///    1e-13 E of the current energy is then accepted when its tangential gradient is smaller.
+///    Close to the minimum the energy change can drop below its round-off; a trial within the
+///    energy's round-off (max(1e-13 E, 8 eps (1 + extent / mean rest) sqrt(E sum C k^2)), which
+///    falls only like sqrt(E) near a perfect map) is then accepted when its tangential gradient is
+///    smaller.
 /// 6. The pair (s, y) is kept when s . y > 1e-12 |s| |y| (curvature condition).
 ///
 /// Stopping: see relaxation.h (tangential gradient only). When particles are held and the

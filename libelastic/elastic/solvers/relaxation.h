@@ -6,9 +6,9 @@
 /// correspondence put them.
 ///
 /// Two solvers, one result (see docs/solvers.md):
-/// - `SolverKind::Fast` (default): tangent-space L-BFGS preconditioned with the prefactored spring
-///   Laplacian, the magnet (closest point) as the retraction, a fold-rejecting Armijo line search
-///   (lbfgs_solver.h).
+/// - `SolverKind::Fast` (default): tangent-space L-BFGS preconditioned with a multigrid V-cycle of
+///   the spring Laplacian, a parametric retraction that agrees with the magnet (closest point) to
+///   third order, a fold-rejecting Armijo line search (lbfgs_solver.h).
 /// - `SolverKind::Faithful`: the paper's damped explicit integrator, eqs. 9-12
 ///   (explicit_integrator.h).
 ///
@@ -154,7 +154,8 @@ struct RelaxationResult {
   StopReason reason = StopReason::MaxIterations;
   /// L-BFGS: the H0 used.
   Preconditioner preconditioner = Preconditioner::Multigrid;
-  double setup_seconds = 0.0;   ///< incidence tables, Laplacian factorisation, normals
+  double setup_seconds =
+      0.0;  ///< incidence tables, Laplacian and its H0 (multigrid or factor), normals
   double solve_seconds = 0.0;   ///< the iterations
   double initial_energy = 0.0;  ///< E_len + E_ang at the start
   double length_energy = 0.0;   ///< final E_len (eq. 13)
