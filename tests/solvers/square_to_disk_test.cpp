@@ -52,6 +52,10 @@ TEST(SquareToDisk, SettlesEveryParticleExceptAFewHeldAtTheCorners) {
   EXPECT_EQ(result.folded_faces, 0);
   EXPECT_LT(result.length_energy + result.angular_energy, result.initial_energy);
   ASSERT_EQ(result.reason, StopReason::FoldConstrained);  // at 2,000 particles the minimum folds
+  // The explicit integrator run from there (RelaxationOptions::untangle_steps) finds no fold-free
+  // equilibrium with lower energy: the stop stands.
+  EXPECT_EQ(result.untangle_steps, options.untangle_steps);
+  EXPECT_FALSE(result.untangled);
 
   // Held particles are few and sit next to the square's corners (the plane is [-1, 1]^2: a corner
   // is at distance sqrt(2) from the centre; "next to" = within a quarter of the side).
@@ -83,6 +87,60 @@ TEST(SquareToDisk, SettlesEveryParticleExceptAFewHeldAtTheCorners) {
     free_sum += (g - n * n.dot(g)).squaredNorm();
   }
   EXPECT_LE(std::sqrt(free_sum), 1e-5 * result.initial_gradient_norm);
+}
+
+}  // namespace
+}  // namespace elastic
+
+namespace elastic {
+namespace {
+
+// A disk of the plane onto the whole goblet (foot, stem and cup, open at the rim): the stem
+// squeezes the grid so hard that the naive map starts with folded faces. The fold-guarded line
+// search does not untangle them and L-BFGS stops against its no-fold constraint; the explicit integrator run from there (RelaxationOptions::untangle_steps) passes
+// through folded states and reaches a fold-free equilibrium of lower energy, which is taken.
+TEST(Untangle, ExplicitStepsLeaveAFoldConstrainedStopOnTheGoblet) {
+  const ShapeOptions shape{.faces = ShapeFaces::Quads, .resolution = 32, .scale = 1.0};
+  const LimitSurface plane(make_plane(shape)), goblet(make_goblet(shape));
+  const SurfaceProjector plane_projector(plane), goblet_projector(goblet);
+  const Region source = make_region(plane_projector, parse_region_spec("disk:0,0,0,0.9"));
+  const Region target = make_region(goblet_projector, parse_region_spec("boundary"));
+  SampleRegionOptions sampling;
+  sampling.layout.particles = 1000;
+  const ParticleGrid grid = sample_region(source, plane_projector, sampling).grid;
+  const RegionDiskMap source_disk(source), target_disk(target);
+  const InitialMap naive = naive_map(grid, source_disk, target_disk);
+  RelaxationProblem problem;
+  problem.grid = &grid;
+  problem.target = &goblet_projector;
+  problem.initial_positions = naive.positions;
+  problem.initial_points = naive.points;
+  problem.rest_scale = rest_scale_factor(
+      RestScale::Boundary, {.source_boundary_length = source.boundary_curve().length(),
+                            .target_boundary_length = target.boundary_curve().length()});
+
+  RelaxationOptions without;
+  without.untangle_steps = 0;
+  const RelaxationResult stuck = relax(problem, without);
+  ASSERT_EQ(stuck.reason, StopReason::FoldConstrained)
+      << "the case no longer needs untangling: " << to_string(stuck.reason);
+  EXPECT_GT(stuck.initial_folded_faces, 0);
+  EXPECT_FALSE(stuck.held_particles.empty());
+
+  const RelaxationResult result = relax(problem, RelaxationOptions{});
+  EXPECT_TRUE(result.untangled);
+  EXPECT_GT(result.untangle_steps, 0);
+  EXPECT_LE(result.untangle_steps, RelaxationOptions{}.untangle_steps);
+  EXPECT_TRUE(result.converged) << to_string(result.reason);
+  EXPECT_LE(result.relative_gradient, 1e-6);
+  EXPECT_EQ(result.folded_faces, 0);
+  EXPECT_TRUE(result.held_particles.empty());
+  EXPECT_LT(result.length_energy + result.angular_energy,
+            stuck.length_energy + stuck.angular_energy);
+  EXPECT_EQ(result.boundary_residual, 0.0);
+  // The fast solver's own record is kept: its iterations, and its initial state.
+  EXPECT_EQ(result.iterations, stuck.iterations);
+  EXPECT_EQ(result.initial_energy, stuck.initial_energy);
 }
 
 }  // namespace

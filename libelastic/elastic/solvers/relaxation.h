@@ -122,10 +122,17 @@ struct RelaxationOptions {
   double relative_gradient_tolerance = 1e-6;  ///< stop when |P g| <= this * initial |P g|
   /// ... or when |P g| <= this * C_max * sigma * mean_rest * sqrt(#P) (scale-free absolute bound)
   double absolute_gradient_tolerance = 1e-10;
-  int threads = 0;                      ///< TBB threads; 0: all available
-  ProgressCallback progress;            ///< called every iteration (L-BFGS) / check (explicit)
-  FrameCallback frame;                  ///< called every `frame_interval` iterations
-  long frame_interval = 1;              ///< k of "every k-th configuration", >= 1
+  int threads = 0;            ///< TBB threads; 0: all available
+  ProgressCallback progress;  ///< called every iteration (L-BFGS) / check (explicit)
+  FrameCallback frame;        ///< called every `frame_interval` iterations
+  long frame_interval = 1;    ///< k of "every k-th configuration", >= 1
+  /// Fast mode: when L-BFGS stops with StopReason::FoldConstrained, up to this many steps of the
+  /// explicit integrator are run from its result. The integrator has no fold guard: it can pass
+  /// through folded states the line search refuses and untangle folds inherited from the start
+  /// (the naive map folds a few faces under extreme compression). Its result is taken only when it
+  /// converges with no more folds and a lower energy; otherwise the fold-constrained stop stands
+  /// (a true folded minimum, e.g. a square onto a disk). 0: off.
+  long untangle_steps = 5000;
   ExplicitOptions explicit_integrator;  ///< faithful-mode parameters
   LbfgsOptions lbfgs;                   ///< fast-mode parameters
 };
@@ -170,7 +177,11 @@ struct RelaxationResult {
   /// L-BFGS: interior particles held where they are at the end because moving them on would fold
   /// a face (non-empty with StopReason::FoldConstrained; they sit next to a nearly flat corner).
   std::vector<int> held_particles;
-  int initial_folded_faces = 0;    ///< the same at the start
+  int initial_folded_faces = 0;  ///< the same at the start
+  /// Fast mode: explicit-integrator steps run after a fold-constrained stop
+  /// (RelaxationOptions::untangle_steps), and whether their equilibrium was taken.
+  long untangle_steps = 0;
+  bool untangled = false;
   double boundary_residual = 0.0;  ///< max distance of a boundary particle from its target position
   double rest_scale = 1.0;         ///< sigma used
   RestScale rest_scale_mode = RestScale::Boundary;  ///< its mode, as given
