@@ -10,6 +10,7 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <string>
 
 #include "elastic/mapping/initial_map.h"
 #include "elastic/projection/closest_point.h"
@@ -22,27 +23,47 @@
 namespace elastic {
 namespace {
 
+// A region of the procedural plane mapped onto a region of another surface by the naive disk map,
+// with the boundary rest scale: the relaxation problem of the tests below, and everything it points
+// into (construct in place; the members reference each other).
+struct NaiveProblem {
+  LimitSurface plane, surface;
+  SurfaceProjector plane_projector, projector;
+  Region source, target;
+  ParticleGrid grid;
+  RelaxationProblem problem;
+
+  NaiveProblem(const ShapeOptions& shape, const PolygonMesh& target_mesh,
+               const std::string& source_spec, long particles, bool adaptive)
+      : plane(make_plane(shape)),
+        surface(target_mesh),
+        plane_projector(plane),
+        projector(surface),
+        source(make_region(plane_projector, parse_region_spec(source_spec))),
+        target(make_region(projector, parse_region_spec("boundary"))) {
+    SampleRegionOptions sampling;
+    sampling.layout.particles = particles;
+    sampling.adaptive = adaptive;
+    grid = sample_region(source, plane_projector, sampling).grid;
+    const RegionDiskMap source_disk(source), target_disk(target);
+    const InitialMap naive = naive_map(grid, source_disk, target_disk);
+    problem.grid = &grid;
+    problem.target = &projector;
+    problem.initial_positions = naive.positions;
+    problem.initial_points = naive.points;
+    problem.rest_scale = rest_scale_factor(
+        RestScale::Boundary, {.source_boundary_length = source.boundary_curve().length(),
+                              .target_boundary_length = target.boundary_curve().length()});
+  }
+};
+
 TEST(SquareToDisk, SettlesEveryParticleExceptAFewHeldAtTheCorners) {
   const ShapeOptions shape{.faces = ShapeFaces::Quads, .resolution = 16, .scale = 1.0};
-  const LimitSurface plane(make_plane(shape)), cap(make_cap(shape));
-  const SurfaceProjector plane_projector(plane), cap_projector(cap);
-  const Region source = make_region(plane_projector, parse_region_spec("boundary"));
-  const Region target = make_region(cap_projector, parse_region_spec("boundary"));
-  SampleRegionOptions sampling;
-  sampling.layout.particles = 2000;  // below ~1,000 the minimum does not fold
-  sampling.adaptive = false;
-  const ParticleGrid grid = sample_region(source, plane_projector, sampling).grid;
-  const RegionDiskMap source_disk(source), target_disk(target);
-  const InitialMap naive = naive_map(grid, source_disk, target_disk);
-
-  RelaxationProblem problem;
-  problem.grid = &grid;
-  problem.target = &cap_projector;
-  problem.initial_positions = naive.positions;
-  problem.initial_points = naive.points;
-  problem.rest_scale = rest_scale_factor(
-      RestScale::Boundary, {.source_boundary_length = source.boundary_curve().length(),
-                            .target_boundary_length = target.boundary_curve().length()});
+  // Below ~1,000 particles the minimum does not fold.
+  const NaiveProblem naive(shape, make_cap(shape), "boundary", 2000, false);
+  const ParticleGrid& grid = naive.grid;
+  const RelaxationProblem& problem = naive.problem;
+  const LimitSurface& cap = naive.surface;
   RelaxationOptions options;
   const RelaxationResult result = relax(problem, options);
 
@@ -89,35 +110,15 @@ TEST(SquareToDisk, SettlesEveryParticleExceptAFewHeldAtTheCorners) {
   EXPECT_LE(std::sqrt(free_sum), 1e-5 * result.initial_gradient_norm);
 }
 
-}  // namespace
-}  // namespace elastic
-
-namespace elastic {
-namespace {
-
 // A disk of the plane onto the whole goblet (foot, stem and cup, open at the rim): the stem
 // squeezes the grid so hard that the naive map starts with folded faces. The fold-guarded line
-// search does not untangle them and L-BFGS stops against its no-fold constraint; the explicit integrator run from there (RelaxationOptions::untangle_steps) passes
-// through folded states and reaches a fold-free equilibrium of lower energy, which is taken.
+// search does not untangle them and L-BFGS stops against its no-fold constraint; the explicit
+// integrator run from there (RelaxationOptions::untangle_steps) passes through folded states and
+// reaches a fold-free equilibrium of lower energy, which is taken.
 TEST(Untangle, ExplicitStepsLeaveAFoldConstrainedStopOnTheGoblet) {
   const ShapeOptions shape{.faces = ShapeFaces::Quads, .resolution = 32, .scale = 1.0};
-  const LimitSurface plane(make_plane(shape)), goblet(make_goblet(shape));
-  const SurfaceProjector plane_projector(plane), goblet_projector(goblet);
-  const Region source = make_region(plane_projector, parse_region_spec("disk:0,0,0,0.9"));
-  const Region target = make_region(goblet_projector, parse_region_spec("boundary"));
-  SampleRegionOptions sampling;
-  sampling.layout.particles = 1000;
-  const ParticleGrid grid = sample_region(source, plane_projector, sampling).grid;
-  const RegionDiskMap source_disk(source), target_disk(target);
-  const InitialMap naive = naive_map(grid, source_disk, target_disk);
-  RelaxationProblem problem;
-  problem.grid = &grid;
-  problem.target = &goblet_projector;
-  problem.initial_positions = naive.positions;
-  problem.initial_points = naive.points;
-  problem.rest_scale = rest_scale_factor(
-      RestScale::Boundary, {.source_boundary_length = source.boundary_curve().length(),
-                            .target_boundary_length = target.boundary_curve().length()});
+  const NaiveProblem naive(shape, make_goblet(shape), "disk:0,0,0,0.9", 1000, true);
+  const RelaxationProblem& problem = naive.problem;
 
   RelaxationOptions without;
   without.untangle_steps = 0;
