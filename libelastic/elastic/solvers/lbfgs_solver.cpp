@@ -46,7 +46,9 @@ template <typename Body>
 void for_chunks(Eigen::Index n, const Body& body, Eigen::Index chunk = kChunk) {
   tbb::parallel_for(tbb::blocked_range<Eigen::Index>(0, n, chunk),
                     [&](const tbb::blocked_range<Eigen::Index>& r) {
-                      for (Eigen::Index i = r.begin(); i != r.end(); ++i) body(i);
+                      for (Eigen::Index i = r.begin(); i != r.end(); ++i) {
+                        body(i);
+                      }
                     });
 }
 
@@ -55,7 +57,9 @@ double sum_chunks(Eigen::Index n, const Term& term) {
   return tbb::parallel_deterministic_reduce(
       tbb::blocked_range<Eigen::Index>(0, n, kChunk), 0.0,
       [&](const tbb::blocked_range<Eigen::Index>& r, double sum) {
-        for (Eigen::Index i = r.begin(); i != r.end(); ++i) sum += term(i);
+        for (Eigen::Index i = r.begin(); i != r.end(); ++i) {
+          sum += term(i);
+        }
         return sum;
       },
       std::plus<double>());
@@ -84,7 +88,9 @@ struct InteriorLayout {
       const Eigen::Vector3d g = gradient.col(p);
       const Eigen::Vector3d nrm = normals.col(p);
       const Eigen::Vector3d t = g - nrm * nrm.dot(g);
-      for (int c = 0; c < 3; ++c) q[c * n + k] = t[c];
+      for (int c = 0; c < 3; ++c) {
+        q[c * n + k] = t[c];
+      }
     });
   }
 
@@ -94,7 +100,9 @@ struct InteriorLayout {
       const Eigen::Vector3d nrm = normals.col(p);
       const Eigen::Vector3d t(v[k], v[n + k], v[2 * n + k]);
       const Eigen::Vector3d u = t - nrm * nrm.dot(t);
-      for (int c = 0; c < 3; ++c) v[c * n + k] = u[c];
+      for (int c = 0; c < 3; ++c) {
+        v[c * n + k] = u[c];
+      }
     });
   }
 
@@ -114,8 +122,9 @@ RelaxationResult relax_lbfgs(const RelaxationProblem& problem, const RelaxationO
   const long long start = solver_detail::now_ticks();
   RelaxationSetup setup(problem, options);
   const LbfgsOptions& lb = options.lbfgs;
-  if (lb.memory < 0 || lb.max_backtracks < 1 || !(lb.armijo > 0.0 && lb.armijo < 1.0))
+  if (lb.memory < 0 || lb.max_backtracks < 1 || !(lb.armijo > 0.0 && lb.armijo < 1.0)) {
     throw InvalidInputError("relaxation", "L-BFGS options out of range");
+  }
 
   RelaxationResult result;
   result.solver = SolverKind::Fast;
@@ -153,14 +162,20 @@ RelaxationResult relax_lbfgs(const RelaxationProblem& problem, const RelaxationO
   int releases = 0;
   const auto is_held = [&](Eigen::Index i) { return held[static_cast<std::size_t>(i % n)] != 0; };
   const auto mask = [&](Eigen::VectorXd& v) {
-    if (held_count == 0) return;
+    if (held_count == 0) {
+      return;
+    }
     for_chunks(m, [&](Eigen::Index i) {
-      if (is_held(i)) v[i] = 0.0;
+      if (is_held(i)) {
+        v[i] = 0.0;
+      }
     });
   };
   // The norm of the rows that are not held.
   const auto free_norm = [&](const Eigen::VectorXd& v) {
-    if (held_count == 0) return std::sqrt(dot(v, v));
+    if (held_count == 0) {
+      return std::sqrt(dot(v, v));
+    }
     return std::sqrt(sum_chunks(m, [&](Eigen::Index i) { return is_held(i) ? 0.0 : v[i] * v[i]; }));
   };
   // out = masked L^-1 (masked v); v is masked in place.
@@ -183,10 +198,12 @@ RelaxationResult relax_lbfgs(const RelaxationProblem& problem, const RelaxationO
   // perfect map (E -> 0) this floor falls only like sqrt(E), far slower than E, and line-search
   // trials that differ from E by less than it are decided on the gradient instead.
   double rest_sum = 0.0;
-  for (const Spring& spring : setup.grid.springs)
+  for (const Spring& spring : setup.grid.springs) {
     rest_sum += options.stiffness * spring.rest * spring.rest;
-  for (const AngularSpring& spring : setup.grid.angular_springs)
+  }
+  for (const AngularSpring& spring : setup.grid.angular_springs) {
     rest_sum += options.angular_stiffness * spring.rest * spring.rest;
+  }
   rest_sum *= problem.rest_scale * problem.rest_scale;
   const double extent = setup.positions.cwiseAbs().maxCoeff();
   const double noise_factor = 8.0 * std::numeric_limits<double>::epsilon() *
@@ -198,7 +215,9 @@ RelaxationResult relax_lbfgs(const RelaxationProblem& problem, const RelaxationO
 
   // The solver's vectors, allocated once (see core/huge_pages.h for why that matters at scale).
   Eigen::VectorXd q, q_free, direction, trial_q;
-  for (Eigen::VectorXd* v : {&q, &q_free, &direction, &trial_q}) resize_huge(*v, m, 1);
+  for (Eigen::VectorXd* v : {&q, &q_free, &direction, &trial_q}) {
+    resize_huge(*v, m, 1);
+  }
   layout.tangential(gradient, setup.normals, q);
   double q_norm = std::sqrt(dot(q, q));
   const double initial_norm = q_norm;
@@ -235,9 +254,10 @@ RelaxationResult relax_lbfgs(const RelaxationProblem& problem, const RelaxationO
   std::vector<char> trial_folded;
 
   const auto emit_frame = [&](long iteration) {
-    if (options.frame && iteration % options.frame_interval == 0)
+    if (options.frame && iteration % options.frame_interval == 0) {
       options.frame({iteration, &setup.positions, energies.total(),
                      initial_norm > 0.0 ? q_norm / initial_norm : 0.0});
+    }
   };
   emit_frame(0);
 
@@ -276,7 +296,9 @@ RelaxationResult relax_lbfgs(const RelaxationProblem& problem, const RelaxationO
       result.reason = StopReason::LineSearchFailed;
       break;
     }
-    if (iteration >= max_iterations) break;
+    if (iteration >= max_iterations) {
+      break;
+    }
     if (!report_progress(options.progress, {.stage = "relax",
                                             .iteration = iteration,
                                             .total = max_iterations,
@@ -360,18 +382,26 @@ RelaxationResult relax_lbfgs(const RelaxationProblem& problem, const RelaxationO
       const bool block_now = fold_halvings >= kFoldHalvings && block_rounds < kMaxBlockRounds;
       bool new_fold = false;
       for (std::size_t c = 0; c < folded.size(); ++c) {
-        if (!trial_folded[c] || folded[c]) continue;
+        if (!trial_folded[c] || folded[c]) {
+          continue;
+        }
         new_fold = true;
-        if (!block_now) break;
+        if (!block_now) {
+          break;
+        }
         // Hold the free particles of the newly folded corner: they keep their position from now
         // on (until a release).
         const SpringSystem::Corner& corner = setup.springs.corners()[c];
         for (const int p : {corner.i, corner.next, corner.prev}) {
           const int k = setup.interior_index[static_cast<std::size_t>(p)];
-          if (k < 0 || held[static_cast<std::size_t>(k)]) continue;
+          if (k < 0 || held[static_cast<std::size_t>(k)]) {
+            continue;
+          }
           held[static_cast<std::size_t>(k)] = 1;
           ++held_count;
-          for (int d = 0; d < 3; ++d) direction[d * n + k] = 0.0;
+          for (int d = 0; d < 3; ++d) {
+            direction[d * n + k] = 0.0;
+          }
         }
       }
       if (new_fold) {
@@ -410,7 +440,9 @@ RelaxationResult relax_lbfgs(const RelaxationProblem& problem, const RelaxationO
           accepted = free_norm(trial_q) < std::sqrt(dot(q_free, q_free));
         }
       }
-      if (accepted) break;
+      if (accepted) {
+        break;
+      }
       alpha *= 0.5;
       ++backtracks;
     }
@@ -423,7 +455,9 @@ RelaxationResult relax_lbfgs(const RelaxationProblem& problem, const RelaxationO
       break;
     }
 
-    if (!trial_q_ready) layout.tangential(trial_gradient, trial_normals, trial_q);
+    if (!trial_q_ready) {
+      layout.tangential(trial_gradient, trial_normals, trial_q);
+    }
     if (next.s.size() != m) {
       resize_huge(next.s, m, 1);
       resize_huge(next.y, m, 1);
@@ -463,9 +497,11 @@ RelaxationResult relax_lbfgs(const RelaxationProblem& problem, const RelaxationO
     emit_frame(iteration + 1);
   }
 
-  for (Eigen::Index k = 0; k < n; ++k)
-    if (held[static_cast<std::size_t>(k)])
+  for (Eigen::Index k = 0; k < n; ++k) {
+    if (held[static_cast<std::size_t>(k)]) {
       result.held_particles.push_back(setup.interior[static_cast<std::size_t>(k)]);
+    }
+  }
   result.iterations = iteration;
   result.solve_seconds = solver_detail::seconds_since(solve_start);
   solver_detail::finish_result(setup, problem, initial_norm, result);

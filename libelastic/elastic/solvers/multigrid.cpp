@@ -37,7 +37,9 @@ template <typename Body>
 void for_rows(int rows, const Body& body) {
   tbb::parallel_for(tbb::blocked_range<int>(0, rows, 2048),
                     [&](const tbb::blocked_range<int>& range) {
-                      for (int i = range.begin(); i != range.end(); ++i) body(i);
+                      for (int i = range.begin(); i != range.end(); ++i) {
+                        body(i);
+                      }
                     });
 }
 
@@ -50,10 +52,14 @@ void sparse_times(const Csr& a, const double* x, double* y) {
          e < a.start[static_cast<std::size_t>(i) + 1]; ++e) {
       const double v = a.value[static_cast<std::size_t>(e)];
       const double* xj = x + static_cast<std::ptrdiff_t>(W) * a.index[static_cast<std::size_t>(e)];
-      for (int w = 0; w < W; ++w) sum[w] += v * xj[w];
+      for (int w = 0; w < W; ++w) {
+        sum[w] += v * xj[w];
+      }
     }
     double* yi = y + static_cast<std::ptrdiff_t>(W) * i;
-    for (int w = 0; w < W; ++w) yi[w] = sum[w];
+    for (int w = 0; w < W; ++w) {
+      yi[w] = sum[w];
+    }
   });
 }
 
@@ -62,13 +68,15 @@ Csr transpose(const Csr& a) {
   t.rows = a.cols;
   t.cols = a.rows;
   assign_huge(t.start, static_cast<std::size_t>(t.rows) + 1, std::int64_t{0});
-  for (const int j : a.index) ++t.start[static_cast<std::size_t>(j) + 1];
+  for (const int j : a.index) {
+    ++t.start[static_cast<std::size_t>(j) + 1];
+  }
   std::partial_sum(t.start.begin(), t.start.end(), t.start.begin());
   assign_huge(t.index, a.nonzeros());
   assign_huge(t.value, a.nonzeros());
   std::vector<std::int64_t> fill(t.start.begin(), t.start.end() - 1);
   // Rows of `a` in increasing order: the columns of each row of the transpose come out sorted.
-  for (int i = 0; i < a.rows; ++i)
+  for (int i = 0; i < a.rows; ++i) {
     for (std::int64_t e = a.start[static_cast<std::size_t>(i)];
          e < a.start[static_cast<std::size_t>(i) + 1]; ++e) {
       const auto slot = static_cast<std::size_t>(
@@ -76,6 +84,7 @@ Csr transpose(const Csr& a) {
       t.index[slot] = i;
       t.value[slot] = a.value[static_cast<std::size_t>(e)];
     }
+  }
   return t;
 }
 
@@ -172,7 +181,9 @@ Csr product(const Csr& a, const Csr& b) {
 // asymmetry of the product, so that the V-cycle is symmetric to the last bit.
 void symmetrise(Csr& a) {
   const Csr t = transpose(a);
-  for (std::size_t e = 0; e < a.value.size(); ++e) a.value[e] = 0.5 * (a.value[e] + t.value[e]);
+  for (std::size_t e = 0; e < a.value.size(); ++e) {
+    a.value[e] = 0.5 * (a.value[e] + t.value[e]);
+  }
 }
 
 // Full symmetric CSR from Eigen's column-major storage (both triangles, or the lower one mirrored).
@@ -181,16 +192,21 @@ Csr from_eigen(const Eigen::SparseMatrix<double>& m, bool lower_only) {
   Csr a;
   a.rows = a.cols = n;
   assign_huge(a.start, static_cast<std::size_t>(n) + 1, std::int64_t{0});
-  for (Eigen::Index col = 0; col < m.outerSize(); ++col)
+  for (Eigen::Index col = 0; col < m.outerSize(); ++col) {
     for (Eigen::SparseMatrix<double>::InnerIterator it(m, col); it; ++it) {
       if (!lower_only) {
         ++a.start[static_cast<std::size_t>(col) + 1];  // column col of a symmetric A is row col
         continue;
       }
-      if (it.row() < col) continue;  // only the lower triangle is read
+      if (it.row() < col) {
+        continue;  // only the lower triangle is read
+      }
       ++a.start[static_cast<std::size_t>(it.row()) + 1];
-      if (it.row() != col) ++a.start[static_cast<std::size_t>(col) + 1];
+      if (it.row() != col) {
+        ++a.start[static_cast<std::size_t>(col) + 1];
+      }
     }
+  }
   std::partial_sum(a.start.begin(), a.start.end(), a.start.begin());
   assign_huge(a.index, static_cast<std::size_t>(a.start.back()));
   assign_huge(a.value, a.index.size());
@@ -202,26 +218,35 @@ Csr from_eigen(const Eigen::SparseMatrix<double>& m, bool lower_only) {
   };
   // Columns in increasing order: row r receives its columns < r first (from the lower triangle),
   // then, at column r, the diagonal and its columns > r (mirrored); both runs are sorted.
-  for (Eigen::Index col = 0; col < m.outerSize(); ++col)
+  for (Eigen::Index col = 0; col < m.outerSize(); ++col) {
     for (Eigen::SparseMatrix<double>::InnerIterator it(m, col); it; ++it) {
       if (!lower_only) {
         put(col, it.row(), it.value());
         continue;
       }
-      if (it.row() < col) continue;
+      if (it.row() < col) {
+        continue;
+      }
       put(it.row(), col, it.value());
-      if (it.row() != col) put(col, it.row(), it.value());
+      if (it.row() != col) {
+        put(col, it.row(), it.value());
+      }
     }
+  }
   // Nothing below needs sorted input rows (products and transposes sort their output).
   return a;
 }
 
 Eigen::VectorXd diagonal(const Csr& a) {
   Eigen::VectorXd d = Eigen::VectorXd::Zero(a.rows);
-  for (int i = 0; i < a.rows; ++i)
+  for (int i = 0; i < a.rows; ++i) {
     for (std::int64_t e = a.start[static_cast<std::size_t>(i)];
-         e < a.start[static_cast<std::size_t>(i) + 1]; ++e)
-      if (a.index[static_cast<std::size_t>(e)] == i) d[i] += a.value[static_cast<std::size_t>(e)];
+         e < a.start[static_cast<std::size_t>(i) + 1]; ++e) {
+      if (a.index[static_cast<std::size_t>(e)] == i) {
+        d[i] += a.value[static_cast<std::size_t>(e)];
+      }
+    }
+  }
   return d;
 }
 
@@ -233,8 +258,9 @@ double spectral_radius(const Csr& a, const Eigen::VectorXd& inv_diag) {
   for (int i = 0; i < a.rows; ++i) {
     double sum = 0.0;
     for (std::int64_t e = a.start[static_cast<std::size_t>(i)];
-         e < a.start[static_cast<std::size_t>(i) + 1]; ++e)
+         e < a.start[static_cast<std::size_t>(i) + 1]; ++e) {
       sum += std::abs(a.value[static_cast<std::size_t>(e)]);
+    }
     gershgorin = std::max(gershgorin, sum * inv_diag[i]);
   }
   // Deterministic pseudo-random start (a multiplicative hash of the index), so that no eigenvector
@@ -257,7 +283,9 @@ double spectral_radius(const Csr& a, const Eigen::VectorXd& inv_diag) {
       y[i] *= inv_diag[i];
       norm += y[i] * y[i];
     }
-    if (!(xd > 0.0) || !(norm > 0.0)) break;
+    if (!(xd > 0.0) || !(norm > 0.0)) {
+      break;
+    }
     estimate = xy / xd;
     x = y / std::sqrt(norm);
   }
@@ -277,23 +305,35 @@ std::vector<int> aggregate(const Csr& a, const Eigen::VectorXd& diag, double the
   count = 0;
   // (1) Nodes whose strong neighbourhood is entirely free found an aggregate.
   for (int i = 0; i < a.rows; ++i) {
-    if (agg[static_cast<std::size_t>(i)] >= 0) continue;
+    if (agg[static_cast<std::size_t>(i)] >= 0) {
+      continue;
+    }
     bool free = true;
     for (std::int64_t e = a.start[static_cast<std::size_t>(i)];
-         free && e < a.start[static_cast<std::size_t>(i) + 1]; ++e)
-      if (strong(i, e) && agg[static_cast<std::size_t>(a.index[static_cast<std::size_t>(e)])] >= 0)
+         free && e < a.start[static_cast<std::size_t>(i) + 1]; ++e) {
+      if (strong(i, e) &&
+          agg[static_cast<std::size_t>(a.index[static_cast<std::size_t>(e)])] >= 0) {
         free = false;
-    if (!free) continue;
+      }
+    }
+    if (!free) {
+      continue;
+    }
     agg[static_cast<std::size_t>(i)] = count;
     for (std::int64_t e = a.start[static_cast<std::size_t>(i)];
-         e < a.start[static_cast<std::size_t>(i) + 1]; ++e)
-      if (strong(i, e)) agg[static_cast<std::size_t>(a.index[static_cast<std::size_t>(e)])] = count;
+         e < a.start[static_cast<std::size_t>(i) + 1]; ++e) {
+      if (strong(i, e)) {
+        agg[static_cast<std::size_t>(a.index[static_cast<std::size_t>(e)])] = count;
+      }
+    }
     ++count;
   }
   // (2) Left-over nodes join the aggregate (from step 1) of their strongest strong neighbour.
   const std::vector<int> first = agg;
   for (int i = 0; i < a.rows; ++i) {
-    if (first[static_cast<std::size_t>(i)] >= 0) continue;
+    if (first[static_cast<std::size_t>(i)] >= 0) {
+      continue;
+    }
     double best = 0.0;
     for (std::int64_t e = a.start[static_cast<std::size_t>(i)];
          e < a.start[static_cast<std::size_t>(i) + 1]; ++e) {
@@ -307,12 +347,16 @@ std::vector<int> aggregate(const Csr& a, const Eigen::VectorXd& diag, double the
   }
   // (3) What is left founds aggregates with its free strong neighbours.
   for (int i = 0; i < a.rows; ++i) {
-    if (agg[static_cast<std::size_t>(i)] >= 0) continue;
+    if (agg[static_cast<std::size_t>(i)] >= 0) {
+      continue;
+    }
     agg[static_cast<std::size_t>(i)] = count;
     for (std::int64_t e = a.start[static_cast<std::size_t>(i)];
          e < a.start[static_cast<std::size_t>(i) + 1]; ++e) {
       const auto j = static_cast<std::size_t>(a.index[static_cast<std::size_t>(e)]);
-      if (strong(i, e) && agg[j] < 0) agg[j] = count;
+      if (strong(i, e) && agg[j] < 0) {
+        agg[j] = count;
+      }
     }
     ++count;
   }
@@ -328,7 +372,9 @@ Csr smoothed_prolongation(const Csr& a, const Eigen::VectorXd& inv_diag,
                       const std::size_t first = index.size();
                       const auto add = [&](int j, double v) {
                         std::size_t k = first;
-                        while (k < index.size() && index[k] < j) ++k;
+                        while (k < index.size() && index[k] < j) {
+                          ++k;
+                        }
                         if (k < index.size() && index[k] == j) {
                           value[k] += v;
                           return;
@@ -339,20 +385,23 @@ Csr smoothed_prolongation(const Csr& a, const Eigen::VectorXd& inv_diag,
                       add(agg[static_cast<std::size_t>(i)], 1.0);
                       const double scale = -omega * inv_diag[i];
                       for (std::int64_t e = a.start[static_cast<std::size_t>(i)];
-                           e < a.start[static_cast<std::size_t>(i) + 1]; ++e)
+                           e < a.start[static_cast<std::size_t>(i) + 1]; ++e) {
                         add(agg[static_cast<std::size_t>(a.index[static_cast<std::size_t>(e)])],
                             scale * a.value[static_cast<std::size_t>(e)]);
+                      }
                     });
 }
 
 Eigen::SparseMatrix<double> to_eigen(const Csr& a) {
   std::vector<Eigen::Triplet<double>> triplets;
   triplets.reserve(a.nonzeros());
-  for (int i = 0; i < a.rows; ++i)
+  for (int i = 0; i < a.rows; ++i) {
     for (std::int64_t e = a.start[static_cast<std::size_t>(i)];
-         e < a.start[static_cast<std::size_t>(i) + 1]; ++e)
+         e < a.start[static_cast<std::size_t>(i) + 1]; ++e) {
       triplets.emplace_back(i, a.index[static_cast<std::size_t>(e)],
                             a.value[static_cast<std::size_t>(e)]);
+    }
+  }
   Eigen::SparseMatrix<double> m(a.rows, a.cols);
   m.setFromTriplets(triplets.begin(), triplets.end());
   return m;
@@ -382,7 +431,9 @@ struct Multigrid::Impl {
     std::vector<Work> w(levels.size());
     for (std::size_t l = 0; l < levels.size(); ++l) {
       const auto size = 3 * static_cast<std::size_t>(levels[l].a.rows);
-      for (auto* v : {&w[l].b, &w[l].x, &w[l].r, &w[l].d, &w[l].t}) assign_huge(*v, size, 0.0);
+      for (auto* v : {&w[l].b, &w[l].x, &w[l].r, &w[l].d, &w[l].t}) {
+        assign_huge(*v, size, 0.0);
+      }
     }
     return w;
   }
@@ -439,30 +490,40 @@ struct Multigrid::Impl {
   // out = b - A x.
   static void residual(const Csr& a, const double* x, const double* b, double* out) {
     for_rows(a.rows, [&](int i) {
-      double sum[3] = {b[3 * i], b[3 * i + 1], b[3 * i + 2]};
+      const std::ptrdiff_t row = 3 * static_cast<std::ptrdiff_t>(i);
+      double sum[3] = {b[row], b[row + 1], b[row + 2]};
       for (std::int64_t e = a.start[static_cast<std::size_t>(i)];
            e < a.start[static_cast<std::size_t>(i) + 1]; ++e) {
         const double v = a.value[static_cast<std::size_t>(e)];
         const double* xj =
             x + 3 * static_cast<std::ptrdiff_t>(a.index[static_cast<std::size_t>(e)]);
-        for (int c = 0; c < 3; ++c) sum[c] -= v * xj[c];
+        for (int c = 0; c < 3; ++c) {
+          sum[c] -= v * xj[c];
+        }
       }
-      for (int c = 0; c < 3; ++c) out[3 * i + c] = sum[c];
+      for (int c = 0; c < 3; ++c) {
+        out[row + c] = sum[c];
+      }
     });
   }
 
   // x += P y.
   static void add_product(const Csr& p, const double* y, double* x) {
     for_rows(p.rows, [&](int i) {
+      const std::ptrdiff_t row = 3 * static_cast<std::ptrdiff_t>(i);
       double sum[3] = {0.0, 0.0, 0.0};
       for (std::int64_t e = p.start[static_cast<std::size_t>(i)];
            e < p.start[static_cast<std::size_t>(i) + 1]; ++e) {
         const double v = p.value[static_cast<std::size_t>(e)];
         const double* yj =
             y + 3 * static_cast<std::ptrdiff_t>(p.index[static_cast<std::size_t>(e)]);
-        for (int c = 0; c < 3; ++c) sum[c] += v * yj[c];
+        for (int c = 0; c < 3; ++c) {
+          sum[c] += v * yj[c];
+        }
       }
-      for (int c = 0; c < 3; ++c) x[3 * i + c] += sum[c];
+      for (int c = 0; c < 3; ++c) {
+        x[row + c] += sum[c];
+      }
     });
   }
 
@@ -486,7 +547,9 @@ struct Multigrid::Impl {
   // `cycles` V-cycles from x = 0 (the stationary iteration x += B (b - A x)).
   void apply(const double* b, double* x, std::vector<Work>& w) const {
     cycle(0, b, x, w);
-    if (options.cycles == 1) return;
+    if (options.cycles == 1) {
+      return;
+    }
     // The level-0 buffers b and x are free at this depth: the residual and the correction.
     double* r = w[0].b.data();
     double* y = w[0].x.data();
@@ -494,7 +557,10 @@ struct Multigrid::Impl {
       residual(levels[0].a, x, b, r);
       cycle(0, r, y, w);
       for_rows(levels[0].a.rows, [&](int i) {
-        for (int k = 0; k < 3; ++k) x[3 * i + k] += y[3 * i + k];
+        const std::ptrdiff_t row = 3 * static_cast<std::ptrdiff_t>(i);
+        for (int k = 0; k < 3; ++k) {
+          x[row + k] += y[row + k];
+        }
       });
     }
   }
@@ -503,39 +569,50 @@ struct Multigrid::Impl {
 Multigrid::Multigrid(const Eigen::SparseMatrix<double>& matrix, bool lower_only,
                      const MultigridOptions& options)
     : impl_(std::make_unique<Impl>()) {
-  if (matrix.rows() != matrix.cols())
+  if (matrix.rows() != matrix.cols()) {
     throw InvalidInputError(kName, "the matrix is not square (" + std::to_string(matrix.rows()) +
                                        " x " + std::to_string(matrix.cols()) + ")");
+  }
   if (!(options.strength_threshold >= 0.0 && options.strength_threshold < 1.0) ||
       options.coarsest_size < 1 || options.max_levels < 1 || options.smoothing_degree < 1 ||
-      !(options.smoothing_range > 1.0) || options.cycles < 1)
+      !(options.smoothing_range > 1.0) || options.cycles < 1) {
     throw InvalidInputError(kName, "options out of range");
+  }
   impl_->options = options;
   Csr a = from_eigen(matrix, lower_only);
   for (;;) {
     Impl::Level level;
     const Eigen::VectorXd diag = diagonal(a);
-    for (Eigen::Index i = 0; i < diag.size(); ++i)
-      if (!(diag[i] > 0.0))
+    for (Eigen::Index i = 0; i < diag.size(); ++i) {
+      if (!(diag[i] > 0.0)) {
         throw InvalidInputError(kName, "diagonal entry " + std::to_string(i) + " of level " +
                                            std::to_string(impl_->levels.size()) +
                                            " is not positive");
+      }
+    }
     level.inv_diag = diag.cwiseInverse();
     const bool last = a.rows <= options.coarsest_size ||
                       static_cast<int>(impl_->levels.size()) + 1 >= options.max_levels;
-    if (!last) level.lambda = spectral_radius(a, level.inv_diag);
+    if (!last) {
+      level.lambda = spectral_radius(a, level.inv_diag);
+    }
     int coarse = 0;
     std::vector<int> agg;
-    if (!last) agg = aggregate(a, diag, options.strength_threshold, coarse);
+    if (!last) {
+      agg = aggregate(a, diag, options.strength_threshold, coarse);
+    }
     // Stop when aggregation no longer coarsens (e.g. a diagonal matrix: every node alone).
     if (last || coarse >= a.rows || coarse == 0) {
       impl_->coarsest.compute(to_eigen(a));
       bool positive = impl_->coarsest.info() == Eigen::Success;
       const Eigen::VectorXd& pivots = impl_->coarsest.vectorD();
-      for (Eigen::Index k = 0; positive && k < pivots.size(); ++k) positive = pivots[k] > 0.0;
-      if (!positive)
+      for (Eigen::Index k = 0; positive && k < pivots.size(); ++k) {
+        positive = pivots[k] > 0.0;
+      }
+      if (!positive) {
         throw NumericalError(kName, "the coarsest level (" + std::to_string(a.rows) +
                                         " unknowns) is not positive definite");
+      }
       level.a = std::move(a);
       impl_->levels.push_back(std::move(level));
       break;
@@ -561,13 +638,18 @@ Multigrid::Block Multigrid::apply(const Block& b) const {
 }
 
 void Multigrid::apply(const Block& b, Block& x) const {
-  if (b.rows() != size())
+  if (b.rows() != size()) {
     throw InvalidInputError(kName, "right-hand side has " + std::to_string(b.rows()) +
                                        " rows, expected " + std::to_string(size()));
-  if (x.rows() != b.rows()) resize_huge(x, b.rows(), 3);
+  }
+  if (x.rows() != b.rows()) {
+    resize_huge(x, b.rows(), 3);
+  }
   std::unique_lock<std::mutex> lock(impl_->mutex, std::try_to_lock);
   if (lock.owns_lock()) {
-    if (impl_->work.empty()) impl_->work = impl_->make_work();
+    if (impl_->work.empty()) {
+      impl_->work = impl_->make_work();
+    }
     impl_->apply(b.data(), x.data(), impl_->work);
   } else {
     std::vector<Impl::Work> own = impl_->make_work();
@@ -582,9 +664,10 @@ Eigen::VectorXd Multigrid::apply(const Eigen::VectorXd& b) const {
 }
 
 Multigrid::Block Multigrid::multiply(const Block& x) const {
-  if (x.rows() != size())
+  if (x.rows() != size()) {
     throw InvalidInputError(kName, "vector has " + std::to_string(x.rows()) + " rows, expected " +
                                        std::to_string(size()));
+  }
   Block y(x.rows(), 3);
   sparse_times<3>(impl_->levels.front().a, x.data(), y.data());
   return y;
@@ -596,13 +679,17 @@ Eigen::Index Multigrid::size() const {
 
 std::vector<Eigen::Index> Multigrid::level_sizes() const {
   std::vector<Eigen::Index> sizes;
-  for (const auto& level : impl_->levels) sizes.push_back(level.a.rows);
+  for (const auto& level : impl_->levels) {
+    sizes.push_back(level.a.rows);
+  }
   return sizes;
 }
 
 double Multigrid::operator_complexity() const {
   double total = 0.0;
-  for (const auto& level : impl_->levels) total += static_cast<double>(level.a.nonzeros());
+  for (const auto& level : impl_->levels) {
+    total += static_cast<double>(level.a.nonzeros());
+  }
   return total / static_cast<double>(std::max<std::size_t>(impl_->levels.front().a.nonzeros(), 1));
 }
 

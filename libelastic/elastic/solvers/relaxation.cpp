@@ -15,8 +15,12 @@ std::string_view to_string(SolverKind kind) {
 }
 
 SolverKind parse_solver_kind(std::string_view text, std::string_view input) {
-  if (text == "fast") return SolverKind::Fast;
-  if (text == "faithful") return SolverKind::Faithful;
+  if (text == "fast") {
+    return SolverKind::Fast;
+  }
+  if (text == "faithful") {
+    return SolverKind::Faithful;
+  }
   throw InvalidInputError(std::string(input),
                           "unknown solver '" + std::string(text) + "' (expected fast or faithful)");
 }
@@ -32,8 +36,12 @@ std::string_view to_string(Preconditioner kind) {
 }
 
 Preconditioner parse_preconditioner(std::string_view text, std::string_view input) {
-  if (text == "direct") return Preconditioner::Direct;
-  if (text == "multigrid") return Preconditioner::Multigrid;
+  if (text == "direct") {
+    return Preconditioner::Direct;
+  }
+  if (text == "multigrid") {
+    return Preconditioner::Multigrid;
+  }
   throw InvalidInputError(std::string(input), "unknown preconditioner '" + std::string(text) +
                                                   "' (expected multigrid or direct)");
 }
@@ -66,7 +74,9 @@ namespace {
 // result (see RelaxationOptions::untangle_steps).
 RelaxationResult relax_fast(const RelaxationProblem& problem, const RelaxationOptions& options) {
   RelaxationResult fast = relax_lbfgs(problem, options);
-  if (fast.reason != StopReason::FoldConstrained || options.untangle_steps <= 0) return fast;
+  if (fast.reason != StopReason::FoldConstrained || options.untangle_steps <= 0) {
+    return fast;
+  }
   RelaxationProblem again = problem;
   again.initial_positions = fast.positions;
   again.initial_points = fast.points;
@@ -81,8 +91,9 @@ RelaxationResult relax_fast(const RelaxationProblem& problem, const RelaxationOp
   fast.evaluations += slow.evaluations;
   const double fast_energy = fast.length_energy + fast.angular_energy;
   const double slow_energy = slow.length_energy + slow.angular_energy;
-  if (!slow.converged || slow.folded_faces > fast.folded_faces || !(slow_energy < fast_energy))
+  if (!slow.converged || slow.folded_faces > fast.folded_faces || !(slow_energy < fast_energy)) {
     return fast;  // a true fold-constrained minimum: the dynamics found nothing better
+  }
   // The integrator's equilibrium replaces the stop. Its tolerance was relative to its own start
   // (the fast solver's last gradient), so relative to the original start it is tighter still.
   fast.positions = slow.positions;
@@ -108,10 +119,15 @@ RelaxationResult relax(const RelaxationProblem& problem, const RelaxationOptions
     return options.solver == SolverKind::Fast ? relax_fast(problem, options)
                                               : relax_explicit(problem, options);
   };
-  if (options.untangle_steps < 0)
+  if (options.untangle_steps < 0) {
     throw InvalidInputError("relaxation", "untangle_steps must be >= 0");
-  if (options.threads < 0) throw InvalidInputError("relaxation", "threads must be >= 0");
-  if (options.threads == 0) return run();
+  }
+  if (options.threads < 0) {
+    throw InvalidInputError("relaxation", "threads must be >= 0");
+  }
+  if (options.threads == 0) {
+    return run();
+  }
   tbb::task_arena arena(options.threads);
   return arena.execute(run);
 }

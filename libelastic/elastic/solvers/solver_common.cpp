@@ -21,8 +21,12 @@ namespace {
 const std::string kName = "relaxation";
 
 const ParticleGrid& checked_grid(const RelaxationProblem& problem) {
-  if (problem.grid == nullptr) throw InvalidInputError(kName, "no particle grid given");
-  if (problem.target == nullptr) throw InvalidInputError(kName, "no target surface given");
+  if (problem.grid == nullptr) {
+    throw InvalidInputError(kName, "no particle grid given");
+  }
+  if (problem.target == nullptr) {
+    throw InvalidInputError(kName, "no target surface given");
+  }
   return *problem.grid;
 }
 
@@ -41,32 +45,42 @@ RelaxationSetup::RelaxationSetup(const RelaxationProblem& problem, const Relaxat
       springs(*problem.grid, energy_options(problem, options)),
       num_particles(problem.grid->num_particles()) {
   const auto P = static_cast<std::size_t>(num_particles);
-  if (problem.initial_positions.cols() != num_particles || problem.initial_points.size() != P)
+  if (problem.initial_positions.cols() != num_particles || problem.initial_points.size() != P) {
     throw InvalidInputError(kName, "initial positions/points do not have one entry per particle (" +
                                        std::to_string(num_particles) + ")");
-  if (grid.is_boundary.size() != P)
+  }
+  if (grid.is_boundary.size() != P) {
     throw InvalidInputError(kName,
                             "particle grid: is_boundary does not have one entry per particle");
-  if (!problem.initial_positions.allFinite())
+  }
+  if (!problem.initial_positions.allFinite()) {
     throw InvalidInputError(kName, "initial positions are not finite");
+  }
   if (problem.boundary_targets.cols() != 0 &&
-      problem.boundary_targets.cols() != static_cast<Eigen::Index>(grid.boundary_loop.size()))
+      problem.boundary_targets.cols() != static_cast<Eigen::Index>(grid.boundary_loop.size())) {
     throw InvalidInputError(kName, "boundary targets do not have one entry per boundary particle");
+  }
   if (!(options.relative_gradient_tolerance >= 0.0) ||
-      !(options.absolute_gradient_tolerance >= 0.0))
+      !(options.absolute_gradient_tolerance >= 0.0)) {
     throw InvalidInputError(kName, "gradient tolerances must be non-negative");
-  if (options.max_iterations < 0 || options.frame_interval < 1 || options.threads < 0)
+  }
+  if (options.max_iterations < 0 || options.frame_interval < 1 || options.threads < 0) {
     throw InvalidInputError(kName, "max_iterations, frame_interval or threads out of range");
-  for (std::size_t p = 0; p < P; ++p)
+  }
+  for (std::size_t p = 0; p < P; ++p) {
     if (!problem.initial_points[p].valid() ||
-        problem.initial_points[p].face >= target.surface().num_faces())
+        problem.initial_points[p].face >= target.surface().num_faces()) {
       throw InvalidInputError(kName,
                               "particle " + std::to_string(p) + " has no valid surface point");
+    }
+  }
 
   interior_index.assign(P, -1);
   is_free.assign(P, 0);
   for (std::size_t p = 0; p < P; ++p) {
-    if (grid.is_boundary[p]) continue;
+    if (grid.is_boundary[p]) {
+      continue;
+    }
     interior_index[p] = static_cast<int>(interior.size());
     is_free[p] = 1;
     interior.push_back(static_cast<int>(p));
@@ -99,7 +113,9 @@ RelaxationSetup::RelaxationSetup(const RelaxationProblem& problem, const Relaxat
                     });
 
   double sum = 0.0;
-  for (const Spring& s : grid.springs) sum += s.rest;
+  for (const Spring& s : grid.springs) {
+    sum += s.rest;
+  }
   mean_rest = grid.springs.empty()
                   ? 0.0
                   : problem.rest_scale * sum / static_cast<double>(grid.springs.size());
@@ -153,16 +169,23 @@ Eigen::SparseMatrix<double> interior_laplacian(const RelaxationSetup& setup,
   Eigen::VectorXd diagonal = Eigen::VectorXd::Zero(n);
   visit([&](int p, int q, double value) {
     const int a = interior(p), b = interior(q);
-    if (a < 0 || b < 0) return;
-    if (a == b)
+    if (a < 0 || b < 0) {
+      return;
+    }
+    if (a == b) {
       diagonal[a] += value;
-    else
+    } else {
       ++start[static_cast<std::size_t>(std::min(a, b)) + 2];
+    }
   });
   // start[c + 2] counts column c's off-diagonal entries; one more slot per column for the
   // diagonal, stored first.
-  for (int c = 0; c < n; ++c) start[static_cast<std::size_t>(c) + 2] += 1;
-  for (std::size_t c = 2; c < start.size(); ++c) start[c] += start[c - 1];
+  for (int c = 0; c < n; ++c) {
+    start[static_cast<std::size_t>(c) + 2] += 1;
+  }
+  for (std::size_t c = 2; c < start.size(); ++c) {
+    start[c] += start[c - 1];
+  }
   std::vector<int> rows;
   std::vector<double> values;
   assign_huge(rows, static_cast<std::size_t>(start.back()));
@@ -175,7 +198,9 @@ Eigen::SparseMatrix<double> interior_laplacian(const RelaxationSetup& setup,
   }
   visit([&](int p, int q, double value) {
     const int a = interior(p), b = interior(q);
-    if (a < 0 || b < 0 || a == b) return;
+    if (a < 0 || b < 0 || a == b) {
+      return;
+    }
     const auto slot =
         static_cast<std::size_t>(start[static_cast<std::size_t>(std::min(a, b)) + 1]++);
     rows[slot] = std::max(a, b);
@@ -188,11 +213,12 @@ Eigen::SparseMatrix<double> interior_laplacian(const RelaxationSetup& setup,
     for (int c = r.begin(); c != r.end(); ++c) {
       const auto first = static_cast<std::size_t>(start[static_cast<std::size_t>(c)]);
       const auto last = static_cast<std::size_t>(start[static_cast<std::size_t>(c) + 1]);
-      for (std::size_t i = first + 1; i < last; ++i)
+      for (std::size_t i = first + 1; i < last; ++i) {
         for (std::size_t j = i; j > first && rows[j - 1] > rows[j]; --j) {
           std::swap(rows[j - 1], rows[j]);
           std::swap(values[j - 1], values[j]);
         }
+      }
       std::size_t out = first;
       for (std::size_t i = first + 1; i < last; ++i) {
         if (rows[i] == rows[out]) {
@@ -208,11 +234,15 @@ Eigen::SparseMatrix<double> interior_laplacian(const RelaxationSetup& setup,
   });
   Eigen::SparseMatrix<double> laplacian(n, n);
   std::int64_t nonzeros = 0;
-  for (const int k : kept) nonzeros += k;
+  for (const int k : kept) {
+    nonzeros += k;
+  }
   laplacian.resizeNonZeros(static_cast<Eigen::Index>(nonzeros));
   int* outer = laplacian.outerIndexPtr();
   outer[0] = 0;
-  for (int c = 0; c < n; ++c) outer[c + 1] = outer[c] + kept[static_cast<std::size_t>(c)];
+  for (int c = 0; c < n; ++c) {
+    outer[c + 1] = outer[c] + kept[static_cast<std::size_t>(c)];
+  }
   tbb::parallel_for(tbb::blocked_range<int>(0, n, 4096), [&](const tbb::blocked_range<int>& r) {
     for (int c = r.begin(); c != r.end(); ++c) {
       const auto from = static_cast<std::ptrdiff_t>(start[static_cast<std::size_t>(c)]);
@@ -228,8 +258,9 @@ Eigen::SparseMatrix<double> interior_laplacian(const RelaxationSetup& setup,
 
 Eigen::Matrix3Xd interior_coordinates(const RelaxationSetup& setup) {
   Eigen::Matrix3Xd x(3, setup.num_free());
-  for (int k = 0; k < setup.num_free(); ++k)
+  for (int k = 0; k < setup.num_free(); ++k) {
     x.col(k) = setup.positions.col(setup.interior[static_cast<std::size_t>(k)]);
+  }
   return x;
 }
 
@@ -307,26 +338,34 @@ std::vector<int> nested_dissection_order(const Eigen::SparseMatrix<double>& lapl
   const auto n = static_cast<std::size_t>(laplacian.rows());
   // Symmetric adjacency from the stored lower triangle.
   std::vector<int> start(n + 1, 0);
-  for (Eigen::Index col = 0; col < laplacian.outerSize(); ++col)
-    for (Eigen::SparseMatrix<double>::InnerIterator it(laplacian, col); it; ++it)
+  for (Eigen::Index col = 0; col < laplacian.outerSize(); ++col) {
+    for (Eigen::SparseMatrix<double>::InnerIterator it(laplacian, col); it; ++it) {
       if (it.row() != col) {
         ++start[static_cast<std::size_t>(it.row()) + 1];
         ++start[static_cast<std::size_t>(col) + 1];
       }
-  for (std::size_t v = 0; v < n; ++v) start[v + 1] += start[v];
+    }
+  }
+  for (std::size_t v = 0; v < n; ++v) {
+    start[v + 1] += start[v];
+  }
   std::vector<int> adjacent(static_cast<std::size_t>(start[n]));
   std::vector<int> fill(start.begin(), start.end() - 1);
-  for (Eigen::Index col = 0; col < laplacian.outerSize(); ++col)
-    for (Eigen::SparseMatrix<double>::InnerIterator it(laplacian, col); it; ++it)
+  for (Eigen::Index col = 0; col < laplacian.outerSize(); ++col) {
+    for (Eigen::SparseMatrix<double>::InnerIterator it(laplacian, col); it; ++it) {
       if (it.row() != col) {
         const auto r = static_cast<std::size_t>(it.row()), c = static_cast<std::size_t>(col);
         adjacent[static_cast<std::size_t>(fill[r]++)] = static_cast<int>(c);
         adjacent[static_cast<std::size_t>(fill[c]++)] = static_cast<int>(r);
       }
+    }
+  }
   std::vector<int> side(n, 0), stamp(n, 0), order;
   order.reserve(n);
   std::vector<int> all(n);
-  for (std::size_t v = 0; v < n; ++v) all[v] = static_cast<int>(v);
+  for (std::size_t v = 0; v < n; ++v) {
+    all[v] = static_cast<int>(v);
+  }
   Dissection{start, adjacent, coordinates, side, stamp, order}.run(std::move(all));
   return order;
 }
@@ -336,36 +375,45 @@ LaplacianFactor::LaplacianFactor(const Eigen::SparseMatrix<double>& laplacian,
     : order_(nested_dissection_order(laplacian, coordinates)) {
   const auto n = static_cast<std::size_t>(laplacian.rows());
   std::vector<int> position(n);
-  for (std::size_t k = 0; k < n; ++k)
+  for (std::size_t k = 0; k < n; ++k) {
     position[static_cast<std::size_t>(order_[k])] = static_cast<int>(k);
+  }
   // P L P^T, lower triangle again.
   std::vector<Eigen::Triplet<double>> triplets;
   triplets.reserve(static_cast<std::size_t>(laplacian.nonZeros()));
-  for (Eigen::Index col = 0; col < laplacian.outerSize(); ++col)
+  for (Eigen::Index col = 0; col < laplacian.outerSize(); ++col) {
     for (Eigen::SparseMatrix<double>::InnerIterator it(laplacian, col); it; ++it) {
       const int a = position[static_cast<std::size_t>(it.row())];
       const int b = position[static_cast<std::size_t>(col)];
       triplets.emplace_back(std::max(a, b), std::min(a, b), it.value());
     }
+  }
   Eigen::SparseMatrix<double> permuted(laplacian.rows(), laplacian.cols());
   permuted.setFromTriplets(triplets.begin(), triplets.end());
   factor_.compute(permuted);
   bool positive = factor_.info() == Eigen::Success;
   const Eigen::VectorXd& pivots = factor_.vectorD();
-  for (Eigen::Index k = 0; positive && k < pivots.size(); ++k) positive = pivots[k] > 0.0;
-  if (!positive)
+  for (Eigen::Index k = 0; positive && k < pivots.size(); ++k) {
+    positive = pivots[k] > 0.0;
+  }
+  if (!positive) {
     throw NumericalError(kName,
                          "the spring Laplacian of the interior particles is singular (an interior "
                          "part of the grid is not connected to the boundary)");
+  }
 }
 
 Eigen::VectorXd LaplacianFactor::solve(const Eigen::VectorXd& b) const {
   const Eigen::Index n = size();
   Eigen::VectorXd permuted(n);
-  for (Eigen::Index k = 0; k < n; ++k) permuted[k] = b[order_[static_cast<std::size_t>(k)]];
+  for (Eigen::Index k = 0; k < n; ++k) {
+    permuted[k] = b[order_[static_cast<std::size_t>(k)]];
+  }
   const Eigen::VectorXd y = factor_.solve(permuted);
   Eigen::VectorXd x(n);
-  for (Eigen::Index k = 0; k < n; ++k) x[order_[static_cast<std::size_t>(k)]] = y[k];
+  for (Eigen::Index k = 0; k < n; ++k) {
+    x[order_[static_cast<std::size_t>(k)]] = y[k];
+  }
   return x;
 }
 
@@ -377,7 +425,9 @@ Eigen::VectorXd LaplacianFactor::solve3(const Eigen::VectorXd& b) const {
   if (n >= 20000) {
     tbb::parallel_for(0, 3, solve_column);
   } else {
-    for (int c = 0; c < 3; ++c) solve_column(c);
+    for (int c = 0; c < 3; ++c) {
+      solve_column(c);
+    }
   }
   return r;
 }
@@ -397,7 +447,9 @@ bool pull_back(const TangentFrame& frame, const Eigen::Vector3d& w, Eigen::Vecto
   const double a = frame.du.squaredNorm(), b = frame.du.dot(frame.dv), c = frame.dv.squaredNorm();
   const double det = a * c - b * b;
   // det = |du x dv|^2: relative to a c it is sin^2 of the angle between du and dv.
-  if (!(det > 1e-12 * a * c)) return false;
+  if (!(det > 1e-12 * a * c)) {
+    return false;
+  }
   const double wu = frame.du.dot(w), wv = frame.dv.dot(w);
   out = Eigen::Vector2d((c * wu - b * wv) / det, (a * wv - b * wu) / det);
   return true;
@@ -409,7 +461,9 @@ bool land(const LimitSurface& surface, const SurfacePoint& to, ClosestPoint& out
   const SurfaceDerivatives d = surface.derivatives(to);
   const Eigen::Vector3d normal = d.du.cross(d.dv);
   const double length = normal.norm();
-  if (!(length > 1e-6 * d.du.norm() * d.dv.norm())) return false;
+  if (!(length > 1e-6 * d.du.norm() * d.dv.norm())) {
+    return false;
+  }
   out.point = to;
   out.position = d.position;
   out.normal = normal / length;
@@ -448,7 +502,9 @@ bool parametric_retraction(const LimitSurface& surface, const SurfacePoint& from
                            const Eigen::Vector3d& x, const TangentFrame& frame,
                            const Eigen::Vector3d& t, ClosestPoint& out, TangentFrame& out_frame) {
   Eigen::Vector2d first;
-  if (!pull_back(frame, t, first)) return false;
+  if (!pull_back(frame, t, first)) {
+    return false;
+  }
   // Second order: d(delta) = x + J delta + 1/2 delta^T H delta + O(delta^3). Removing the tangent
   // part of the quadratic term makes the tangent displacement t + O(|t|^3), like the closest point
   // of x + t, so the L-BFGS pairs see the same curvature as with the magnet.
@@ -456,20 +512,32 @@ bool parametric_retraction(const LimitSurface& surface, const SurfacePoint& from
       0.5 * (first.x() * first.x() * frame.duu + 2.0 * first.x() * first.y() * frame.duv +
              first.y() * first.y() * frame.dvv);
   Eigen::Vector2d correction;
-  if (!pull_back(frame, bend, correction)) return false;
+  if (!pull_back(frame, bend, correction)) {
+    return false;
+  }
   SurfacePoint to = surface.walk(from, first - correction);
-  if (surface.on_boundary(to) || !land(surface, to, out, out_frame)) return false;
+  if (surface.on_boundary(to) || !land(surface, to, out, out_frame)) {
+    return false;
+  }
   const Eigen::Vector3d goal = x + t;
   const double allowed = kRetractionMiss * t.norm();
   for (int k = 0;; ++k) {
     const Eigen::Vector3d miss = goal - out.position;
     const Eigen::Vector3d tangential = miss - out.normal * out.normal.dot(miss);
-    if (tangential.norm() <= allowed) return true;
-    if (k == kRetractionCorrections) return false;
+    if (tangential.norm() <= allowed) {
+      return true;
+    }
+    if (k == kRetractionCorrections) {
+      return false;
+    }
     Eigen::Vector2d step;
-    if (!pull_back(out_frame, tangential, step)) return false;
+    if (!pull_back(out_frame, tangential, step)) {
+      return false;
+    }
     to = surface.walk(to, step);
-    if (surface.on_boundary(to) || !land(surface, to, out, out_frame)) return false;
+    if (surface.on_boundary(to) || !land(surface, to, out, out_frame)) {
+      return false;
+    }
   }
 }
 
@@ -502,20 +570,28 @@ void LaplacianInverse::solve3(const Eigen::VectorXd& b, Eigen::VectorXd& x) cons
     resize_huge(block_b_, n, 3);
     resize_huge(block_x_, n, 3);
   }
-  if (x.size() != 3 * n) resize_huge(x, 3 * n, 1);
+  if (x.size() != 3 * n) {
+    resize_huge(x, 3 * n, 1);
+  }
   // Column blocks <-> rows of three, in parallel chunks.
   const auto rows = [&](const auto& body) {
     tbb::parallel_for(tbb::blocked_range<Eigen::Index>(0, n, 16384),
                       [&](const tbb::blocked_range<Eigen::Index>& r) {
-                        for (Eigen::Index i = r.begin(); i != r.end(); ++i) body(i);
+                        for (Eigen::Index i = r.begin(); i != r.end(); ++i) {
+                          body(i);
+                        }
                       });
   };
   rows([&](Eigen::Index i) {
-    for (int c = 0; c < 3; ++c) block_b_(i, c) = b[c * n + i];
+    for (int c = 0; c < 3; ++c) {
+      block_b_(i, c) = b[c * n + i];
+    }
   });
   multigrid_->apply(block_b_, block_x_);
   rows([&](Eigen::Index i) {
-    for (int c = 0; c < 3; ++c) x[c * n + i] = block_x_(i, c);
+    for (int c = 0; c < 3; ++c) {
+      x[c * n + i] = block_x_(i, c);
+    }
   });
 }
 
