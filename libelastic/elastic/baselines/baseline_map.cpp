@@ -32,7 +32,9 @@ std::string_view to_string(BaselineKind kind) {
 
 BaselineKind parse_baseline_kind(std::string_view text, std::string_view input) {
   for (BaselineKind kind : {BaselineKind::Lscm, BaselineKind::Arap, BaselineKind::Dcm}) {
-    if (text == to_string(kind)) return kind;
+    if (text == to_string(kind)) {
+      return kind;
+    }
   }
   throw InvalidInputError(std::string(input), "unknown baseline '" + std::string(text) +
                                                   "' (expected lscm, arap or dcm)");
@@ -101,12 +103,16 @@ class RegionPointLocator {
     std::vector<std::vector<int>> face_triangles(static_cast<size_t>(num_faces));
     for (int t = 0; t < region.num_triangles(); ++t) {
       const int f = region.triangle_face[static_cast<size_t>(t)];
-      if (f >= 0 && f < num_faces) face_triangles[static_cast<size_t>(f)].push_back(t);
+      if (f >= 0 && f < num_faces) {
+        face_triangles[static_cast<size_t>(f)].push_back(t);
+      }
     }
     locators_.resize(static_cast<size_t>(num_faces));
     triangles_ = std::move(face_triangles);
     for (size_t f = 0; f < triangles_.size(); ++f) {
-      if (triangles_[f].empty()) continue;
+      if (triangles_[f].empty()) {
+        continue;
+      }
       std::vector<Eigen::Vector2d> corners;
       std::vector<Eigen::Vector3i> local;
       for (int t : triangles_[f]) {
@@ -150,7 +156,9 @@ class RegionPointLocator {
         w = wk;
       }
     }
-    if (t < 0) return false;
+    if (t < 0) {
+      return false;
+    }
     const Eigen::Vector3i& tri = region.triangles[static_cast<size_t>(t)];
     const double size = (region.positions[static_cast<size_t>(tri[1])] -
                          region.positions[static_cast<size_t>(tri[0])])
@@ -176,12 +184,16 @@ class BoundaryParametrisation {
       : region_(&region), curve_(region.boundary_curve()) {
     cumulative_ = curve_.arc_lengths();
     total_ = curve_.length();
-    if (!(total_ > 0.0)) throw InvalidInputError(name, "region boundary has zero length");
+    if (!(total_ > 0.0)) {
+      throw InvalidInputError(name, "region boundary has zero length");
+    }
     std::map<std::pair<int, int>, std::pair<int, int>>
         edge_triangle;  // (a, b) -> (triangle, corner of a)
     for (int t = 0; t < region.num_triangles(); ++t) {
       const Eigen::Vector3i& tri = region.triangles[static_cast<size_t>(t)];
-      for (int k = 0; k < 3; ++k) edge_triangle[{tri[k], tri[(k + 1) % 3]}] = {t, k};
+      for (int k = 0; k < 3; ++k) {
+        edge_triangle[{tri[k], tri[(k + 1) % 3]}] = {t, k};
+      }
     }
     const size_t n = region.boundary.size();
     edge_triangle_.resize(n);
@@ -233,7 +245,9 @@ void check_region(const Region& region, const SurfaceProjector& projector,
   if (region.surface == nullptr || region.triangles.empty()) {
     throw InvalidInputError(name, "region is empty (no triangles)");
   }
-  if (region.boundary.size() < 3) throw InvalidInputError(name, "region has no boundary loop");
+  if (region.boundary.size() < 3) {
+    throw InvalidInputError(name, "region has no boundary loop");
+  }
   if (region.surface != &projector.surface()) {
     throw InvalidInputError(name, "region does not lie on the projector's surface");
   }
@@ -251,13 +265,17 @@ BaselineResult map_baseline(const ParticleGrid& grid, const SurfaceProjector& so
                             const Region& target_region, const BaselineOptions& options) {
   const auto start = std::chrono::steady_clock::now();
   const int n = grid.num_particles();
-  if (n == 0) throw InvalidInputError("grid", "particle grid is empty");
+  if (n == 0) {
+    throw InvalidInputError("grid", "particle grid is empty");
+  }
   if (grid.source_points.size() != static_cast<size_t>(n) ||
       grid.is_boundary.size() != static_cast<size_t>(n) ||
       grid.boundary_parameter.size() != grid.boundary_loop.size()) {
     throw InvalidInputError("grid", "particle arrays have inconsistent sizes");
   }
-  if (grid.boundary_loop.empty()) throw InvalidInputError("grid", "particle grid has no boundary");
+  if (grid.boundary_loop.empty()) {
+    throw InvalidInputError("grid", "particle grid has no boundary");
+  }
   check_region(source_region, source, "source region");
   check_region(target_region, target, "target region");
   if (options.alignment_samples < 3) {
@@ -293,8 +311,12 @@ BaselineResult map_baseline(const ParticleGrid& grid, const SurfaceProjector& so
           target_error = std::current_exception();
         }
       });
-  if (source_error) std::rethrow_exception(source_error);
-  if (target_error) std::rethrow_exception(target_error);
+  if (source_error) {
+    std::rethrow_exception(source_error);
+  }
+  if (target_error) {
+    std::rethrow_exception(target_error);
+  }
   result.source_flipped_triangles = from.flipped_triangles;
   result.target_flipped_triangles = to.flipped_triangles;
 
@@ -325,8 +347,9 @@ BaselineResult map_baseline(const ParticleGrid& grid, const SurfaceProjector& so
     cross += std::conj(pc) * (q[static_cast<size_t>(j)] - q_mean);
     norm2 += std::norm(pc);
   }
-  if (!(norm2 > 0.0))
+  if (!(norm2 > 0.0)) {
     throw NumericalError("source region", "flattened boundary collapsed to a point");
+  }
   const Complex a = cross / norm2;
   const Complex b = q_mean - a * p_mean;
   if (!(std::abs(a) > 0.0)) {
@@ -346,7 +369,9 @@ BaselineResult map_baseline(const ParticleGrid& grid, const SurfaceProjector& so
   std::vector<double> parameter(static_cast<size_t>(n), -1.0);
   for (size_t k = 0; k < grid.boundary_loop.size(); ++k) {
     const int i = grid.boundary_loop[k];
-    if (i < 0 || i >= n) throw InvalidInputError("grid", "boundary particle index out of range");
+    if (i < 0 || i >= n) {
+      throw InvalidInputError("grid", "boundary particle index out of range");
+    }
     parameter[static_cast<size_t>(i)] = grid.boundary_parameter[k];
   }
   result.positions.resize(3, n);

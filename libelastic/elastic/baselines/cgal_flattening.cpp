@@ -47,7 +47,9 @@ std::vector<double> boundary_parameters(const Region& region) {
   std::vector<double> s(arc.size());
   for (size_t k = 0; k < arc.size(); ++k) {
     double value = std::fmod(arc[k] / total - region.anchor, 1.0);
-    if (value < 0.0) value += 1.0;
+    if (value < 0.0) {
+      value += 1.0;
+    }
     s[k] = value;
   }
   return s;
@@ -103,7 +105,9 @@ class CachedSparseLuTraits : public CGAL::Eigen_solver_traits<
       cache.matrix.makeCompressed();
       cache.lu.compute(cache.matrix);
       cache.valid = cache.lu.info() == Eigen::Success;
-      if (!cache.valid) return false;
+      if (!cache.valid) {
+        return false;
+      }
     }
     X = cache.lu.solve(B);
     return cache.lu.info() == Eigen::Success;
@@ -152,17 +156,23 @@ CgalFlattening flatten_region_cgal(const Region& region, BaselineKind kind,
   if (region.positions.empty() || region.triangles.empty()) {
     throw InvalidInputError(name, "region is empty (no triangles)");
   }
-  if (region.boundary.size() < 3) throw InvalidInputError(name, "region has no boundary loop");
+  if (region.boundary.size() < 3) {
+    throw InvalidInputError(name, "region has no boundary loop");
+  }
   const int nv = region.num_vertices();
   for (int v : region.boundary) {
-    if (v < 0 || v >= nv) throw InvalidInputError(name, "boundary vertex index out of range");
+    if (v < 0 || v >= nv) {
+      throw InvalidInputError(name, "boundary vertex index out of range");
+    }
   }
 
   // The region as a CGAL Surface_mesh: vertex i of the mesh is region vertex i.
   Mesh mesh;
   mesh.reserve(static_cast<Mesh::size_type>(nv), static_cast<Mesh::size_type>(3 * nv),
                static_cast<Mesh::size_type>(region.num_triangles()));
-  for (const Eigen::Vector3d& p : region.positions) mesh.add_vertex(Point3(p.x(), p.y(), p.z()));
+  for (const Eigen::Vector3d& p : region.positions) {
+    mesh.add_vertex(Point3(p.x(), p.y(), p.z()));
+  }
   for (const Eigen::Vector3i& t : region.triangles) {
     if (t.minCoeff() < 0 || t.maxCoeff() >= nv || t[0] == t[1] || t[1] == t[2] || t[0] == t[2]) {
       throw InvalidInputError(name, "region triangle with an invalid vertex index");
@@ -181,18 +191,26 @@ CgalFlattening flatten_region_cgal(const Region& region, BaselineKind kind,
   {
     std::vector<char> seen(mesh.number_of_halfedges(), 0);
     for (HalfedgeIndex h : mesh.halfedges()) {
-      if (!mesh.is_border(h) || seen[h.idx()]) continue;
+      if (!mesh.is_border(h) || seen[h.idx()]) {
+        continue;
+      }
       ++border_cycles;
-      for (HalfedgeIndex g : CGAL::halfedges_around_face(h, mesh)) seen[g.idx()] = 1;
+      for (HalfedgeIndex g : CGAL::halfedges_around_face(h, mesh)) {
+        seen[g.idx()] = 1;
+      }
     }
     // The border halfedge leaving boundary vertex 0: a deterministic start for CGAL's traversals.
     const VertexIndex v0(static_cast<Mesh::size_type>(region.boundary[0]));
     for (HalfedgeIndex h : CGAL::halfedges_around_source(v0, mesh)) {
-      if (mesh.is_border(h)) bhd = h;
+      if (mesh.is_border(h)) {
+        bhd = h;
+      }
     }
   }
   long used_vertices = 0;
-  for (VertexIndex v : mesh.vertices()) used_vertices += mesh.is_isolated(v) ? 0 : 1;
+  for (VertexIndex v : mesh.vertices()) {
+    used_vertices += mesh.is_isolated(v) ? 0 : 1;
+  }
   const long euler = used_vertices - static_cast<long>(mesh.number_of_edges()) +
                      static_cast<long>(mesh.number_of_faces());
   if (border_cycles != 1 || euler != 1 || bhd == Mesh::null_halfedge()) {
@@ -265,7 +283,9 @@ CgalFlattening flatten_region_cgal(const Region& region, BaselineKind kind,
     return 0.5 * (e1.x() * e2.y() - e1.y() * e2.x());
   };
   double area = 0.0;
-  for (const Eigen::Vector3i& t : region.triangles) area += signed_area(t);
+  for (const Eigen::Vector3i& t : region.triangles) {
+    area += signed_area(t);
+  }
   const double area3d = region.area();
   if (!(area3d > 0.0) || !std::isfinite(area) || area == 0.0) {
     throw NumericalError(name, "CGAL parameterization has zero or non-finite area");
@@ -274,9 +294,13 @@ CgalFlattening flatten_region_cgal(const Region& region, BaselineKind kind,
   // orientation of their triangles (the alignment fits rotations only, never reflections).
   const double mirror = area < 0.0 ? -1.0 : 1.0;
   result.scale = std::sqrt(area3d / std::abs(area));
-  for (Eigen::Vector2d& p : result.uv) p = result.scale * Eigen::Vector2d(p.x(), mirror * p.y());
+  for (Eigen::Vector2d& p : result.uv) {
+    p = result.scale * Eigen::Vector2d(p.x(), mirror * p.y());
+  }
   for (const Eigen::Vector3i& t : region.triangles) {
-    if (!(signed_area(t) > 0.0)) ++result.flipped_triangles;
+    if (!(signed_area(t) > 0.0)) {
+      ++result.flipped_triangles;
+    }
   }
   return result;
 }

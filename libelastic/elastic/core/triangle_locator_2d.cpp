@@ -10,7 +10,9 @@ TriangleLocator2D::TriangleLocator2D(std::vector<Eigen::Vector2d> vertices,
                                      std::vector<Eigen::Vector3i> triangles,
                                      double cells_per_triangle)
     : vertices_(std::move(vertices)), triangles_(std::move(triangles)) {
-  if (triangles_.empty()) return;
+  if (triangles_.empty()) {
+    return;
+  }
   Eigen::Vector2d lo = Eigen::Vector2d::Constant(std::numeric_limits<double>::infinity());
   Eigen::Vector2d hi = -lo;
   for (const Eigen::Vector3i& t : triangles_) {
@@ -23,7 +25,9 @@ TriangleLocator2D::TriangleLocator2D(std::vector<Eigen::Vector2d> vertices,
   // Square cells, about cells_per_triangle * #T of them over the bounding box.
   const double cells = std::max(1.0, cells_per_triangle * static_cast<double>(triangles_.size()));
   cell_size_ = std::sqrt(extent.x() * extent.y() / cells);
-  if (!(cell_size_ > 0.0)) cell_size_ = std::max(extent.x(), extent.y());
+  if (!(cell_size_ > 0.0)) {
+    cell_size_ = std::max(extent.x(), extent.y());
+  }
   nx_ = std::clamp(static_cast<int>(std::ceil(extent.x() / cell_size_)), 1, 1 << 14);
   ny_ = std::clamp(static_cast<int>(std::ceil(extent.y() / cell_size_)), 1, 1 << 14);
   cell_size_ = std::max(extent.x() / nx_, extent.y() / ny_);
@@ -37,15 +41,22 @@ TriangleLocator2D::TriangleLocator2D(std::vector<Eigen::Vector2d> vertices,
     int x0, y0, x1, y1;
     cell_range(a.cwiseMin(b).cwiseMin(c), a.cwiseMax(b).cwiseMax(c), x0, y0, x1, y1);
     for (int y = y0; y <= y1; ++y) {
-      for (int x = x0; x <= x1; ++x) f(y * nx_ + x);
+      for (int x = x0; x <= x1; ++x) {
+        f(y * nx_ + x);
+      }
     }
   };
-  for (int t = 0; t < num_triangles(); ++t) for_each_cell(t, [&](int c) { ++counts[c + 1]; });
-  for (size_t c = 1; c < counts.size(); ++c) counts[c] += counts[c - 1];
+  for (int t = 0; t < num_triangles(); ++t) {
+    for_each_cell(t, [&](int c) { ++counts[c + 1]; });
+  }
+  for (size_t c = 1; c < counts.size(); ++c) {
+    counts[c] += counts[c - 1];
+  }
   cell_start_ = counts;
   cell_items_.resize(counts.back());
-  for (int t = 0; t < num_triangles(); ++t)
+  for (int t = 0; t < num_triangles(); ++t) {
     for_each_cell(t, [&](int c) { cell_items_[counts[c]++] = t; });
+  }
 }
 
 void TriangleLocator2D::cell_range(const Eigen::Vector2d& lo, const Eigen::Vector2d& hi, int& x0,
@@ -74,7 +85,9 @@ Eigen::Vector3d TriangleLocator2D::barycentric(int t, const Eigen::Vector2d& p) 
 
 TriangleLocator2D::Hit TriangleLocator2D::locate(const Eigen::Vector2d& p, double tolerance) const {
   Hit best;
-  if (triangles_.empty() || !p.allFinite()) return best;
+  if (triangles_.empty() || !p.allFinite()) {
+    return best;
+  }
   const Eigen::Vector2d slack = Eigen::Vector2d::Constant(tolerance * cell_size_);
   int x0, y0, x1, y1;
   cell_range(p - slack, p + slack, x0, y0, x1, y1);
@@ -87,9 +100,13 @@ TriangleLocator2D::Hit TriangleLocator2D::locate(const Eigen::Vector2d& p, doubl
       for (int k = cell_start_[c]; k < cell_start_[c + 1]; ++k) {
         const int t = cell_items_[k];
         const Eigen::Vector3d w = barycentric(t, p);
-        if (!w.allFinite()) continue;
+        if (!w.allFinite()) {
+          continue;
+        }
         const double m = w.minCoeff();
-        if (m < -tolerance) continue;
+        if (m < -tolerance) {
+          continue;
+        }
         if (best.triangle < 0 || m > best_min || (m == best_min && t < best.triangle)) {
           best_min = m;
           best.triangle = t;
@@ -113,7 +130,9 @@ double segment_parameter(const Eigen::Vector2d& a, const Eigen::Vector2d& b,
 
 TriangleLocator2D::Hit TriangleLocator2D::nearest(const Eigen::Vector2d& p) const {
   Hit inside = locate(p);
-  if (inside.found() || triangles_.empty()) return inside;
+  if (inside.found() || triangles_.empty()) {
+    return inside;
+  }
   // Search rings of cells outward until a candidate is found and the ring is farther than the best.
   Hit best;
   double best_d2 = std::numeric_limits<double>::infinity();
@@ -127,11 +146,17 @@ TriangleLocator2D::Hit TriangleLocator2D::nearest(const Eigen::Vector2d& p) cons
   for (int ring = 0; ring < std::max(nx_, ny_); ++ring) {
     // Every cell of this ring is at least this far from p (a conservative lower bound).
     const double ring_distance = std::max(outside, (ring - 1) * cell_size_);
-    if (best.found() && ring_distance * ring_distance > best_d2) break;
+    if (best.found() && ring_distance * ring_distance > best_d2) {
+      break;
+    }
     for (int y = cy - ring; y <= cy + ring; ++y) {
       for (int x = cx - ring; x <= cx + ring; ++x) {
-        if (std::max(std::abs(x - cx), std::abs(y - cy)) != ring) continue;
-        if (x < 0 || y < 0 || x >= nx_ || y >= ny_) continue;
+        if (std::max(std::abs(x - cx), std::abs(y - cy)) != ring) {
+          continue;
+        }
+        if (x < 0 || y < 0 || x >= nx_ || y >= ny_) {
+          continue;
+        }
         const int c = y * nx_ + x;
         for (int k = cell_start_[c]; k < cell_start_[c + 1]; ++k) {
           const int t = cell_items_[k];

@@ -64,7 +64,9 @@ Eigen::Vector4f emblem_at(const Eigen::Vector2d& p, const EmblemOptions& options
   const Eigen::Vector4f background = options.transparent_background
                                          ? Eigen::Vector4f(0.0f, 0.0f, 0.0f, 0.0f)
                                          : Eigen::Vector4f(1.0f, 1.0f, 1.0f, 1.0f);
-  if (r > kRingOuter) return background;
+  if (r > kRingOuter) {
+    return background;
+  }
   if (r > kDiskRadius) {
     // Screen y is down, so -d.y() is up: hue grows counter-clockwise as seen.
     const double angle = std::atan2(-d.y(), d.x());
@@ -116,7 +118,9 @@ Image make_emblem(int size, const EmblemOptions& options) {
         }
       }
       Eigen::Vector4f pixel = sum / static_cast<float>(s * s);
-      if (pixel.w() > 0.0f) pixel.head<3>() /= pixel.w();
+      if (pixel.w() > 0.0f) {
+        pixel.head<3>() /= pixel.w();
+      }
       image.at(x, y) = pixel;
     }
   }

@@ -37,11 +37,15 @@ int wrap_index(int i, int n, ImageWrap wrap) {
 }  // namespace
 
 Eigen::Vector4f sample(const Image& image, const Eigen::Vector2d& uv, ImageWrap wrap) {
-  if (image.empty()) return Eigen::Vector4f::Zero();
+  if (image.empty()) {
+    return Eigen::Vector4f::Zero();
+  }
   // Continuous pixel coordinates whose integer + 0.5 points are pixel centres (x right, y down).
   const double x = uv.x() * image.width - 0.5;
   const double y = (1.0 - uv.y()) * image.height - 0.5;
-  if (!std::isfinite(x) || !std::isfinite(y)) return Eigen::Vector4f::Zero();
+  if (!std::isfinite(x) || !std::isfinite(y)) {
+    return Eigen::Vector4f::Zero();
+  }
   // Clamp far-away coordinates before the integer conversion (the result is the same).
   const double xc = std::clamp(x, -4.0 * image.width, 5.0 * image.width);
   const double yc = std::clamp(y, -4.0 * image.height, 5.0 * image.height);
@@ -57,7 +61,9 @@ Eigen::Vector4f sample(const Image& image, const Eigen::Vector2d& uv, ImageWrap 
 
 Image read_image(const std::filesystem::path& path) {
   const std::string name = path.string();
-  if (!std::ifstream(path, std::ios::binary)) throw IoError(name, "cannot open the image");
+  if (!std::ifstream(path, std::ios::binary)) {
+    throw IoError(name, "cannot open the image");
+  }
   int columns = 0, rows = 0, channels = 0;
   if (!stbi_info(name.c_str(), &columns, &rows, &channels) || columns <= 0 || rows <= 0) {
     throw InvalidInputError(name,
@@ -78,7 +84,9 @@ Image read_image(const std::filesystem::path& path) {
   Image image(columns, rows);
   const stbi_uc* p = data.get();
   for (Eigen::Vector4f& pixel : image.pixels) {
-    for (int k = 0; k < 4; ++k) pixel[k] = static_cast<float>(*p++) / 255.0f;
+    for (int k = 0; k < 4; ++k) {
+      pixel[k] = static_cast<float>(*p++) / 255.0f;
+    }
   }
   return image;
 }
@@ -95,7 +103,9 @@ void write_png(const std::filesystem::path& path, const Image& image) {
           name, "pixel " + std::to_string(i % static_cast<size_t>(image.width)) + "," +
                     std::to_string(i / static_cast<size_t>(image.width)) + " is not finite");
     }
-    if (image.pixels[i][3] < 1.0f) opaque = false;
+    if (image.pixels[i][3] < 1.0f) {
+      opaque = false;
+    }
   }
   const int channels = opaque ? 3 : 4;
   std::vector<unsigned char> bytes;

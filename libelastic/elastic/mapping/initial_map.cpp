@@ -26,7 +26,9 @@ Eigen::Vector3d barycentric(const Eigen::Vector2d& a, const Eigen::Vector2d& b,
                             const Eigen::Vector2d& c, const Eigen::Vector2d& p) {
   const Eigen::Vector2d e1 = b - a, e2 = c - a, d = p - a;
   const double det = e1.x() * e2.y() - e1.y() * e2.x();
-  if (det == 0.0) return Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
+  if (det == 0.0) {
+    return Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
+  }
   const double b1 = (d.x() * e2.y() - d.y() * e2.x()) / det;
   const double b2 = (e1.x() * d.y() - e1.y() * d.x()) / det;
   return {1.0 - b1 - b2, b1, b2};
@@ -107,8 +109,12 @@ RegionDiskMap::RegionDiskMap(const Region& region) : region_(&region) {
     locators->boundary_corners[k] = it->second.second;
   }
   const double total = locators->boundary_arc[n];
-  if (!(total > 0.0)) throw InvalidInputError("region", "boundary has zero length");
-  for (double& a : locators->boundary_arc) a /= total;
+  if (!(total > 0.0)) {
+    throw InvalidInputError("region", "boundary has zero length");
+  }
+  for (double& a : locators->boundary_arc) {
+    a /= total;
+  }
   locators_ = std::move(locators);
 }
 
@@ -127,7 +133,9 @@ bool RegionDiskMap::to_disk(const SurfacePoint& p, Eigen::Vector2d& disk) const 
     for (int t : locators_->face_triangles[p.face]) {
       const auto& uv = region.triangle_uv[t];
       const Eigen::Vector3d w = barycentric(uv[0], uv[1], uv[2], p.uv());
-      if (!w.allFinite()) continue;
+      if (!w.allFinite()) {
+        continue;
+      }
       if (w.minCoeff() > best_min) {
         best_min = w.minCoeff();
         best = t;
@@ -156,23 +164,32 @@ bool RegionDiskMap::to_disk(const SurfacePoint& p, Eigen::Vector2d& disk) const 
       best_w = w;
     }
   }
-  if (best < 0) return false;
+  if (best < 0) {
+    return false;
+  }
   // Accept points within a small fraction of the triangle's size (chord error of the tessellation).
   const Eigen::Vector3i& tri = region.triangles[best];
   const double size = (region.positions[tri[1]] - region.positions[tri[0]]).norm() +
                       (region.positions[tri[2]] - region.positions[tri[0]]).norm();
-  if (best_d2 > (0.05 * size) * (0.05 * size)) return false;
+  if (best_d2 > (0.05 * size) * (0.05 * size)) {
+    return false;
+  }
   interpolate(best, best_w);
   return true;
 }
 
 bool RegionDiskMap::from_disk(const Eigen::Vector2d& disk, SurfacePoint& p,
                               double tolerance) const {
-  if (!disk.allFinite() || disk.norm() > 1.0 + tolerance) return false;
+  if (!disk.allFinite() || disk.norm() > 1.0 + tolerance) {
+    return false;
+  }
   TriangleLocator2D::Hit hit = locators_->disk.locate(disk, 1e-12);
-  if (!hit.found())
+  if (!hit.found()) {
     hit = locators_->disk.nearest(disk);  // between the circle and its inscribed polygon
-  if (!hit.found()) return false;
+  }
+  if (!hit.found()) {
+    return false;
+  }
   p = region_->point_in_triangle(hit.triangle, hit.barycentric[1], hit.barycentric[2]);
   return true;
 }
@@ -182,7 +199,9 @@ SurfacePoint RegionDiskMap::boundary_point(double s) const {
   const std::vector<double>& arc = locators_->boundary_arc;
   const int n = static_cast<int>(region.boundary.size());
   double a = std::fmod(region.anchor + s, 1.0);
-  if (a < 0.0) a += 1.0;
+  if (a < 0.0) {
+    a += 1.0;
+  }
   // Segment k with arc[k] <= a < arc[k+1].
   const int k = std::clamp(
       static_cast<int>(std::upper_bound(arc.begin(), arc.end(), a) - arc.begin()) - 1, 0, n - 1);

@@ -21,7 +21,9 @@ MapResult map_regions(const SurfaceProjector& source, const Region& source_regio
   if (target_region.surface != &target.surface()) {
     throw InvalidInputError("target region", "does not lie on the target surface");
   }
-  if (options.subdivisions < 0) throw InvalidInputError("subdivisions", "must be 0 or more");
+  if (options.subdivisions < 0) {
+    throw InvalidInputError("subdivisions", "must be 0 or more");
+  }
   auto stage = [&](std::string_view name) {
     if (!report_progress(options.progress, {.stage = name})) {
       throw Error("map", "cancelled during " + std::string(name));

@@ -33,7 +33,9 @@ std::vector<Eigen::Vector3i> grid_triangles(const GridMesh& mesh) {
   triangles.reserve(mesh.n_faces() * 2);
   for (const auto fh : mesh.faces()) {
     std::vector<int> corners;
-    for (const auto vh : mesh.fv_range(fh)) corners.push_back(vh.idx());
+    for (const auto vh : mesh.fv_range(fh)) {
+      corners.push_back(vh.idx());
+    }
     for (size_t k = 1; k + 1 < corners.size(); ++k) {
       triangles.emplace_back(corners[0], corners[k], corners[k + 1]);
     }
@@ -53,15 +55,18 @@ std::vector<std::array<int, 3>> triangle_neighbours(const std::vector<Eigen::Vec
   edge_owner.reserve(triangles.size() * 3);
   for (size_t t = 0; t < triangles.size(); ++t) {
     const Eigen::Vector3i& tri = triangles[t];
-    for (int k = 0; k < 3; ++k)
+    for (int k = 0; k < 3; ++k) {
       edge_owner.emplace(key(tri[k], tri[(k + 1) % 3]), static_cast<int>(t));
+    }
   }
   std::vector<std::array<int, 3>> neighbours(triangles.size(), {-1, -1, -1});
   for (size_t t = 0; t < triangles.size(); ++t) {
     const Eigen::Vector3i& tri = triangles[t];
     for (int k = 0; k < 3; ++k) {
       const auto it = edge_owner.find(key(tri[(k + 2) % 3], tri[(k + 1) % 3]));
-      if (it != edge_owner.end()) neighbours[t][static_cast<size_t>(k)] = it->second;
+      if (it != edge_owner.end()) {
+        neighbours[t][static_cast<size_t>(k)] = it->second;
+      }
     }
   }
   return neighbours;
@@ -76,7 +81,9 @@ bool plane_weights(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eig
   const double g11 = e1.dot(e1), g12 = e1.dot(e2), g22 = e2.dot(e2);
   const double det = g11 * g22 - g12 * g12;  // |e1 x e2|^2
   // Relative to g11 g22 this is sin^2 of the triangle's angle at a: 1e-24 means an angle of 1e-12.
-  if (!(det > 1e-24 * g11 * g22)) return false;
+  if (!(det > 1e-24 * g11 * g22)) {
+    return false;
+  }
   const double r1 = e1.dot(d), r2 = e2.dot(d);
   const double b1 = (g22 * r1 - g12 * r2) / det, b2 = (g11 * r2 - g12 * r1) / det;
   w = Eigen::Vector3d(1.0 - b1 - b2, b1, b2);
@@ -89,7 +96,9 @@ bool plane_weights(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eig
 // query, and on an edge shared with a neighbour both triangles clamp to the same point.
 Eigen::Vector3d clamp_to_triangle(const std::array<Eigen::Vector3d, 3>& corners,
                                   const Eigen::Vector3d& w) {
-  if (w.minCoeff() >= 0.0) return w;
+  if (w.minCoeff() >= 0.0) {
+    return w;
+  }
   const Eigen::Vector3d p = w[0] * corners[0] + w[1] * corners[1] + w[2] * corners[2];
   Eigen::Vector3d best = Eigen::Vector3d::Zero();
   double best_distance = std::numeric_limits<double>::infinity();
@@ -148,8 +157,12 @@ struct Mapping::Impl {
                const Eigen::Vector2d& disk, const Eigen::Vector3d& x) const {
     TriangleLocator2D::Hit guess = locator.locate(disk, 1e-9);
     const bool disk_inside = guess.found();
-    if (!disk_inside) guess = locator.nearest(disk);
-    if (!guess.found()) return {};
+    if (!disk_inside) {
+      guess = locator.nearest(disk);
+    }
+    if (!guess.found()) {
+      return {};
+    }
 
     int t = guess.triangle;
     Eigen::Vector3d w;
@@ -172,7 +185,9 @@ struct Mapping::Impl {
         best = t;
         best_weights = w;
       }
-      if (w.minCoeff() >= -kRoundOff) return {t, w};
+      if (w.minCoeff() >= -kRoundOff) {
+        return {t, w};
+      }
 
       // Cross the edge opposite the most negative weight; if that edge is on the grid's boundary
       // (or leads back to a visited triangle), the next most negative one, which lets the walk
@@ -182,21 +197,28 @@ struct Mapping::Impl {
       int next = -1;
       Eigen::Vector3d next_weights;
       for (const int k : order) {
-        if (w[k] >= -kRoundOff) break;
+        if (w[k] >= -kRoundOff) {
+          break;
+        }
         const int n = neighbours[static_cast<size_t>(t)][static_cast<size_t>(k)];
         if (n < 0) {
           met_boundary = true;
           continue;
         }
         if (std::find(visited.begin(), visited.begin() + num_visited, n) !=
-            visited.begin() + num_visited)
+            visited.begin() + num_visited) {
           continue;
+        }
         const auto c = corners(positions, n);
-        if (!plane_weights(c[0], c[1], c[2], x, next_weights)) continue;
+        if (!plane_weights(c[0], c[1], c[2], x, next_weights)) {
+          continue;
+        }
         next = n;
         break;
       }
-      if (next < 0 || num_visited == kMaxWalkSteps) break;
+      if (next < 0 || num_visited == kMaxWalkSteps) {
+        break;
+      }
       t = next;
       w = next_weights;
     }
@@ -206,7 +228,9 @@ struct Mapping::Impl {
     // triangles whose planes leave a gap (a query above an edge where the grid bends) or ran out
     // of steps: clamped too. Clamping is onto the least-outside triangle visited; across an edge
     // shared by two triangles both clamp to the same point of it, so this is continuous.
-    if (met_boundary && !disk_inside) return {};
+    if (met_boundary && !disk_inside) {
+      return {};
+    }
     return {best, clamp_to_triangle(corners(positions, best), best_weights)};
   }
 
@@ -270,19 +294,27 @@ Mapping::Mapping(const ParticleGrid& grid, const SurfaceProjector& source,
 
 Mapping::Location Mapping::forward(const SurfacePoint& source_point) const {
   Eigen::Vector2d disk;
-  if (!impl_ || !impl_->source_disk->to_disk(source_point, disk)) return {};
+  if (!impl_ || !impl_->source_disk->to_disk(source_point, disk)) {
+    return {};
+  }
   const Impl::Found found = impl_->locate(impl_->source_locator, impl_->source_positions, disk,
                                           impl_->source->surface().position(source_point));
-  if (found.triangle < 0) return {};
+  if (found.triangle < 0) {
+    return {};
+  }
   return impl_->land(*impl_->target, impl_->target_positions, impl_->target_points, found);
 }
 
 Mapping::Location Mapping::inverse(const SurfacePoint& target_point) const {
   Eigen::Vector2d disk;
-  if (!impl_ || !impl_->target_disk->to_disk(target_point, disk)) return {};
+  if (!impl_ || !impl_->target_disk->to_disk(target_point, disk)) {
+    return {};
+  }
   const Impl::Found found = impl_->locate(impl_->target_locator, impl_->target_positions, disk,
                                           impl_->target->surface().position(target_point));
-  if (found.triangle < 0) return {};
+  if (found.triangle < 0) {
+    return {};
+  }
   return impl_->land(*impl_->source, impl_->source_positions, impl_->source_points, found);
 }
 

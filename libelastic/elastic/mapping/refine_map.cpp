@@ -36,7 +36,9 @@ RefineMapResult refine_map(const ParticleGrid& grid, const RelaxationResult& rel
                                       std::to_string(relaxed.positions.cols()) + " positions for " +
                                       std::to_string(np) + " particles");
   }
-  if (options.levels < 0) throw InvalidInputError(name, "negative number of subdivision levels");
+  if (options.levels < 0) {
+    throw InvalidInputError(name, "negative number of subdivision levels");
+  }
   if (options.relaxation.solver != SolverKind::Fast) {
     throw InvalidInputError(name, "refinement relaxes with the fast solver only");
   }

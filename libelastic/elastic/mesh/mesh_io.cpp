@@ -23,17 +23,29 @@ std::string lower_extension(const std::filesystem::path& path) {
 
 std::string read_whole_file(const std::filesystem::path& path) {
   std::error_code ec;
-  if (!std::filesystem::exists(path, ec)) throw IoError(path.string(), "no such file");
-  if (std::filesystem::is_directory(path, ec)) throw IoError(path.string(), "is a directory");
+  if (!std::filesystem::exists(path, ec)) {
+    throw IoError(path.string(), "no such file");
+  }
+  if (std::filesystem::is_directory(path, ec)) {
+    throw IoError(path.string(), "is a directory");
+  }
   std::ifstream in(path, std::ios::binary);
-  if (!in) throw IoError(path.string(), std::string("cannot open: ") + std::strerror(errno));
+  if (!in) {
+    throw IoError(path.string(), std::string("cannot open: ") + std::strerror(errno));
+  }
   in.seekg(0, std::ios::end);
   const std::streamoff size = in.tellg();
-  if (size < 0) throw IoError(path.string(), "cannot determine the file size");
+  if (size < 0) {
+    throw IoError(path.string(), "cannot determine the file size");
+  }
   in.seekg(0, std::ios::beg);
   std::string bytes(static_cast<size_t>(size), '\0');
-  if (size > 0 && !in.read(bytes.data(), size)) throw IoError(path.string(), "read failed");
-  if (bytes.empty()) throw InvalidInputError(path.string(), "empty file");
+  if (size > 0 && !in.read(bytes.data(), size)) {
+    throw IoError(path.string(), "read failed");
+  }
+  if (bytes.empty()) {
+    throw InvalidInputError(path.string(), "empty file");
+  }
   return bytes;
 }
 
@@ -47,13 +59,17 @@ void check_writable(const PolygonMesh& mesh, const std::filesystem::path& path) 
       fail("inconsistent face offsets");
     }
     for (int f = 0; f < mesh.num_faces(); ++f) {
-      if (mesh.face_size(f) < 3) fail("face " + std::to_string(f) + " has fewer than 3 corners");
+      if (mesh.face_size(f) < 3) {
+        fail("face " + std::to_string(f) + " has fewer than 3 corners");
+      }
     }
   } else if (!mesh.face_vertices.empty()) {
     fail("face corners without face offsets");
   }
   for (int v : mesh.face_vertices) {
-    if (v < 0 || v >= nv) fail("face vertex index " + std::to_string(v) + " out of range");
+    if (v < 0 || v >= nv) {
+      fail("face vertex index " + std::to_string(v) + " out of range");
+    }
   }
   for (int v = 0; v < nv; ++v) {
     if (!mesh.positions[static_cast<size_t>(v)].allFinite()) {
@@ -61,12 +77,16 @@ void check_writable(const PolygonMesh& mesh, const std::filesystem::path& path) 
     }
   }
   auto check_corners = [&](const std::vector<int>& corners, size_t pool, const char* what) {
-    if (corners.empty()) return;
+    if (corners.empty()) {
+      return;
+    }
     if (corners.size() != mesh.face_vertices.size()) {
       fail(std::string(what) + ": one index per face corner expected");
     }
     for (int i : corners) {
-      if (i < 0 || static_cast<size_t>(i) >= pool) fail(std::string(what) + " index out of range");
+      if (i < 0 || static_cast<size_t>(i) >= pool) {
+        fail(std::string(what) + " index out of range");
+      }
     }
   };
   check_corners(mesh.corner_texcoords, mesh.texcoords.size(), "texture coordinates");
@@ -83,15 +103,20 @@ void check_writable(const PolygonMesh& mesh, const std::filesystem::path& path) 
       fail("face materials: one per face expected");
     }
     for (int m : mesh.face_materials) {
-      if (m < -1 || m >= static_cast<int>(mesh.materials.size()))
+      if (m < -1 || m >= static_cast<int>(mesh.materials.size())) {
         fail("material index out of range");
+      }
     }
   }
   for (const Crease& c : mesh.creases) {
-    if (c.v0 < 0 || c.v0 >= nv || c.v1 < 0 || c.v1 >= nv) fail("crease vertex out of range");
+    if (c.v0 < 0 || c.v0 >= nv || c.v1 < 0 || c.v1 >= nv) {
+      fail("crease vertex out of range");
+    }
   }
   for (const auto& c : mesh.corners) {
-    if (c.first < 0 || c.first >= nv) fail("corner vertex out of range");
+    if (c.first < 0 || c.first >= nv) {
+      fail("corner vertex out of range");
+    }
   }
 }
 
@@ -99,17 +124,27 @@ void check_writable(const PolygonMesh& mesh, const std::filesystem::path& path) 
 
 MeshFormat format_from_extension(const std::filesystem::path& path) {
   const std::string ext = detail::lower_extension(path);
-  if (ext == ".obj") return MeshFormat::Obj;
-  if (ext == ".off") return MeshFormat::Off;
-  if (ext == ".ply") return MeshFormat::Ply;
-  if (ext == ".stl") return MeshFormat::Stl;
+  if (ext == ".obj") {
+    return MeshFormat::Obj;
+  }
+  if (ext == ".off") {
+    return MeshFormat::Off;
+  }
+  if (ext == ".ply") {
+    return MeshFormat::Ply;
+  }
+  if (ext == ".stl") {
+    return MeshFormat::Stl;
+  }
   return MeshFormat::Auto;
 }
 
 namespace {
 
 MeshFormat resolve_format(const std::filesystem::path& path, MeshFormat format) {
-  if (format != MeshFormat::Auto) return format;
+  if (format != MeshFormat::Auto) {
+    return format;
+  }
   const MeshFormat from_name = format_from_extension(path);
   if (from_name == MeshFormat::Auto) {
     throw InvalidInputError(path.string(), "unknown mesh format '" + path.extension().string() +
@@ -140,7 +175,9 @@ MeshReadResult read_mesh(const std::filesystem::path& path, const MeshReadOption
     case MeshFormat::Auto:
       break;
   }
-  if (result.mesh.num_faces() == 0) throw InvalidInputError(path.string(), "the file has no faces");
+  if (result.mesh.num_faces() == 0) {
+    throw InvalidInputError(path.string(), "the file has no faces");
+  }
   return result;
 }
 

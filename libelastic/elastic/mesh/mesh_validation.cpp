@@ -35,18 +35,25 @@ class DisjointSets {
 };
 
 void note(IndexFindings& findings, int index, int max_examples) {
-  if (findings.count++ < max_examples) findings.examples.push_back(index);
+  if (findings.count++ < max_examples) {
+    findings.examples.push_back(index);
+  }
 }
 
 void note(EdgeFindings& findings, int a, int b, int max_examples) {
-  if (findings.count++ < max_examples)
+  if (findings.count++ < max_examples) {
     findings.examples.emplace_back(std::min(a, b), std::max(a, b));
+  }
 }
 
 bool face_is_wellformed(const PolygonMesh& mesh, int f) {
-  if (mesh.face_size(f) < 3) return false;
+  if (mesh.face_size(f) < 3) {
+    return false;
+  }
   for (int v : mesh.face(f)) {
-    if (v < 0 || v >= mesh.num_vertices()) return false;
+    if (v < 0 || v >= mesh.num_vertices()) {
+      return false;
+    }
   }
   return true;
 }
@@ -79,12 +86,16 @@ EdgeTable build_edges(const PolygonMesh& mesh, const std::vector<char>& face_ok)
   std::vector<Side> sides;
   sides.reserve(mesh.face_vertices.size());
   for (int f = 0; f < mesh.num_faces(); ++f) {
-    if (!face_ok[static_cast<size_t>(f)]) continue;
+    if (!face_ok[static_cast<size_t>(f)]) {
+      continue;
+    }
     const auto face = mesh.face(f);
     for (size_t k = 0; k < face.size(); ++k) {
       const int a = face[k];
       const int b = face[(k + 1) % face.size()];
-      if (a == b) continue;
+      if (a == b) {
+        continue;
+      }
       sides.push_back({std::min(a, b), std::max(a, b), f, a < b});
     }
   }
@@ -135,7 +146,9 @@ bool solve_orientation(const PolygonMesh& mesh, const std::vector<char>& face_ok
   std::vector<std::vector<std::pair<int, bool>>> adjacency(static_cast<size_t>(nf));
   for (size_t e = 0; e < table.edges.size(); ++e) {
     const auto u = table.uses(e);
-    if (u.size() != 2 || u[0].face == u[1].face) continue;
+    if (u.size() != 2 || u[0].face == u[1].face) {
+      continue;
+    }
     const bool differ = u[0].forward == u[1].forward;
     adjacency[static_cast<size_t>(u[0].face)].emplace_back(u[1].face, differ);
     adjacency[static_cast<size_t>(u[1].face)].emplace_back(u[0].face, differ);
@@ -146,7 +159,9 @@ bool solve_orientation(const PolygonMesh& mesh, const std::vector<char>& face_ok
   std::vector<int> stack;
   std::vector<int> members;
   for (int start = 0; start < nf; ++start) {
-    if (seen[static_cast<size_t>(start)] || !face_ok[static_cast<size_t>(start)]) continue;
+    if (seen[static_cast<size_t>(start)] || !face_ok[static_cast<size_t>(start)]) {
+      continue;
+    }
     members.clear();
     stack.assign(1, start);
     seen[static_cast<size_t>(start)] = 1;
@@ -168,7 +183,9 @@ bool solve_orientation(const PolygonMesh& mesh, const std::vector<char>& face_ok
     const auto flipped = std::count_if(members.begin(), members.end(),
                                        [&](int f) { return flip[static_cast<size_t>(f)] != 0; });
     if (2 * static_cast<size_t>(flipped) > members.size()) {
-      for (int f : members) flip[static_cast<size_t>(f)] ^= 1;
+      for (int f : members) {
+        flip[static_cast<size_t>(f)] ^= 1;
+      }
     }
   }
   return orientable;
@@ -176,13 +193,17 @@ bool solve_orientation(const PolygonMesh& mesh, const std::vector<char>& face_ok
 
 std::string edge_list(const std::vector<std::pair<int, int>>& edges) {
   std::ostringstream s;
-  for (const auto& [a, b] : edges) s << " (" << a << ", " << b << ")";
+  for (const auto& [a, b] : edges) {
+    s << " (" << a << ", " << b << ")";
+  }
   return s.str();
 }
 
 std::string index_list(const std::vector<int>& indices) {
   std::ostringstream s;
-  for (int i : indices) s << ' ' << i;
+  for (int i : indices) {
+    s << ' ' << i;
+  }
   return s.str();
 }
 
@@ -238,7 +259,9 @@ std::vector<std::string> MeshValidation::describe() const {
   if (num_components > 1) {
     std::ostringstream s;
     s << num_components << " connected components (faces per component:";
-    for (size_t i = 0; i < component_faces.size() && i < 10; ++i) s << ' ' << component_faces[i];
+    for (size_t i = 0; i < component_faces.size() && i < 10; ++i) {
+      s << ' ' << component_faces[i];
+    }
     s << (component_faces.size() > 10 ? " ...)" : ")");
     lines.push_back(s.str());
   }
@@ -272,7 +295,9 @@ MeshValidation validate_mesh(const PolygonMesh& mesh, const ValidationOptions& o
       continue;
     }
     const auto face = mesh.face(f);
-    for (int v : face) referenced[static_cast<size_t>(v)] = 1;
+    for (int v : face) {
+      referenced[static_cast<size_t>(v)] = 1;
+    }
     sorted.assign(face.begin(), face.end());
     std::sort(sorted.begin(), sorted.end());
     if (std::adjacent_find(sorted.begin(), sorted.end()) != sorted.end()) {
@@ -280,7 +305,9 @@ MeshValidation validate_mesh(const PolygonMesh& mesh, const ValidationOptions& o
       continue;  // its area is not looked at: the two findings are disjoint
     }
     bool finite = true;
-    for (int v : face) finite = finite && mesh.positions[static_cast<size_t>(v)].allFinite();
+    for (int v : face) {
+      finite = finite && mesh.positions[static_cast<size_t>(v)].allFinite();
+    }
     if (finite && is_zero_area(mesh, f, options.zero_area_relative_tolerance)) {
       note(result.zero_area_faces, f, max_examples);
     }
@@ -312,7 +339,9 @@ MeshValidation validate_mesh(const PolygonMesh& mesh, const ValidationOptions& o
   {
     std::vector<char> root_seen(static_cast<size_t>(nv), 0);
     for (size_t e = 0; e < table.edges.size(); ++e) {
-      if (table.uses(e).size() != 1) continue;
+      if (table.uses(e).size() != 1) {
+        continue;
+      }
       const int r = boundary.find(table.edges[e].first);
       if (!root_seen[static_cast<size_t>(r)]) {
         root_seen[static_cast<size_t>(r)] = 1;
@@ -325,16 +354,24 @@ MeshValidation validate_mesh(const PolygonMesh& mesh, const ValidationOptions& o
   {
     DisjointSets sets(nv);
     for (int f = 0; f < nf; ++f) {
-      if (!face_ok[static_cast<size_t>(f)]) continue;
+      if (!face_ok[static_cast<size_t>(f)]) {
+        continue;
+      }
       const auto face = mesh.face(f);
-      for (size_t k = 1; k < face.size(); ++k) sets.unite(face[0], face[k]);
+      for (size_t k = 1; k < face.size(); ++k) {
+        sets.unite(face[0], face[k]);
+      }
     }
     std::unordered_map<int, int> faces_per_root;
     for (int f = 0; f < nf; ++f) {
-      if (face_ok[static_cast<size_t>(f)]) ++faces_per_root[sets.find(mesh.face(f)[0])];
+      if (face_ok[static_cast<size_t>(f)]) {
+        ++faces_per_root[sets.find(mesh.face(f)[0])];
+      }
     }
     result.num_components = static_cast<int>(faces_per_root.size());
-    for (const auto& [root, count] : faces_per_root) result.component_faces.push_back(count);
+    for (const auto& [root, count] : faces_per_root) {
+      result.component_faces.push_back(count);
+    }
     std::sort(result.component_faces.begin(), result.component_faces.end(), std::greater<>());
   }
 
@@ -346,7 +383,9 @@ MeshValidation validate_mesh(const PolygonMesh& mesh, const ValidationOptions& o
     std::vector<int> start(static_cast<size_t>(nv) + 1, 0);
     std::vector<int> last_face(static_cast<size_t>(nv), -1);
     for (int f = 0; f < nf; ++f) {
-      if (!face_ok[static_cast<size_t>(f)]) continue;
+      if (!face_ok[static_cast<size_t>(f)]) {
+        continue;
+      }
       for (int v : mesh.face(f)) {
         if (last_face[static_cast<size_t>(v)] != f) {
           last_face[static_cast<size_t>(v)] = f;
@@ -354,12 +393,16 @@ MeshValidation validate_mesh(const PolygonMesh& mesh, const ValidationOptions& o
         }
       }
     }
-    for (int v = 0; v < nv; ++v) start[static_cast<size_t>(v) + 1] += start[static_cast<size_t>(v)];
+    for (int v = 0; v < nv; ++v) {
+      start[static_cast<size_t>(v) + 1] += start[static_cast<size_t>(v)];
+    }
     std::vector<int> incident(static_cast<size_t>(start.back()));
     std::vector<int> fill(start.begin(), start.end() - 1);
     std::fill(last_face.begin(), last_face.end(), -1);
     for (int f = 0; f < nf; ++f) {
-      if (!face_ok[static_cast<size_t>(f)]) continue;
+      if (!face_ok[static_cast<size_t>(f)]) {
+        continue;
+      }
       for (int v : mesh.face(f)) {
         if (last_face[static_cast<size_t>(v)] != f) {
           last_face[static_cast<size_t>(v)] = f;
@@ -423,19 +466,31 @@ void keep_faces(PolygonMesh& mesh, const std::vector<char>& keep) {
   std::vector<int> normals;
   std::vector<int> materials;
   for (int f = 0; f < mesh.num_faces(); ++f) {
-    if (!keep[static_cast<size_t>(f)]) continue;
+    if (!keep[static_cast<size_t>(f)]) {
+      continue;
+    }
     const auto b = static_cast<size_t>(mesh.face_offsets[static_cast<size_t>(f)]);
     const auto e = static_cast<size_t>(mesh.face_offsets[static_cast<size_t>(f) + 1]);
     for (size_t c = b; c < e; ++c) {
       vertices.push_back(mesh.face_vertices[c]);
-      if (uv) uvs.push_back(mesh.corner_texcoords[c]);
-      if (nrm) normals.push_back(mesh.corner_normals[c]);
+      if (uv) {
+        uvs.push_back(mesh.corner_texcoords[c]);
+      }
+      if (nrm) {
+        normals.push_back(mesh.corner_normals[c]);
+      }
     }
     offsets.push_back(static_cast<int>(vertices.size()));
-    if (mat) materials.push_back(mesh.face_materials[static_cast<size_t>(f)]);
-    if (col) colors.push_back(mesh.face_colors[static_cast<size_t>(f)]);
+    if (mat) {
+      materials.push_back(mesh.face_materials[static_cast<size_t>(f)]);
+    }
+    if (col) {
+      colors.push_back(mesh.face_colors[static_cast<size_t>(f)]);
+    }
   }
-  if (offsets.size() == 1) offsets.clear();
+  if (offsets.size() == 1) {
+    offsets.clear();
+  }
   mesh.face_offsets = std::move(offsets);
   mesh.face_vertices = std::move(vertices);
   mesh.corner_texcoords = std::move(uvs);
@@ -465,7 +520,9 @@ void flip_face(PolygonMesh& mesh, int f) {
 int remove_unreferenced(PolygonMesh& mesh) {
   const int nv = mesh.num_vertices();
   std::vector<int> remap(static_cast<size_t>(nv), -1);
-  for (int v : mesh.face_vertices) remap[static_cast<size_t>(v)] = 0;
+  for (int v : mesh.face_vertices) {
+    remap[static_cast<size_t>(v)] = 0;
+  }
   int next = 0;
   for (int v = 0; v < nv; ++v) {
     if (remap[static_cast<size_t>(v)] == 0) {
@@ -477,10 +534,16 @@ int remove_unreferenced(PolygonMesh& mesh) {
       ++next;
     }
   }
-  if (next == nv) return 0;
+  if (next == nv) {
+    return 0;
+  }
   mesh.positions.resize(static_cast<size_t>(next));
-  if (mesh.has_vertex_colors()) mesh.vertex_colors.resize(static_cast<size_t>(next));
-  for (int& v : mesh.face_vertices) v = remap[static_cast<size_t>(v)];
+  if (mesh.has_vertex_colors()) {
+    mesh.vertex_colors.resize(static_cast<size_t>(next));
+  }
+  for (int& v : mesh.face_vertices) {
+    v = remap[static_cast<size_t>(v)];
+  }
   auto gone = [&](int v) { return v < 0 || v >= nv || remap[static_cast<size_t>(v)] < 0; };
   std::erase_if(mesh.creases, [&](const Crease& c) { return gone(c.v0) || gone(c.v1); });
   for (Crease& c : mesh.creases) {
@@ -488,7 +551,9 @@ int remove_unreferenced(PolygonMesh& mesh) {
     c.v1 = remap[static_cast<size_t>(c.v1)];
   }
   std::erase_if(mesh.corners, [&](const std::pair<int, double>& c) { return gone(c.first); });
-  for (auto& c : mesh.corners) c.first = remap[static_cast<size_t>(c.first)];
+  for (auto& c : mesh.corners) {
+    c.first = remap[static_cast<size_t>(c.first)];
+  }
   return nv - next;
 }
 
@@ -540,7 +605,9 @@ RepairResult repair_mesh(PolygonMesh& mesh, const RepairOptions& options) {
     DisjointSets sets(mesh.num_vertices());
     for (int f = 0; f < mesh.num_faces(); ++f) {
       const auto face = mesh.face(f);
-      for (size_t k = 1; k < face.size(); ++k) sets.unite(face[0], face[k]);
+      for (size_t k = 1; k < face.size(); ++k) {
+        sets.unite(face[0], face[k]);
+      }
     }
     std::unordered_map<int, int> count;
     std::unordered_map<int, int> first_face;
@@ -576,7 +643,9 @@ RepairResult repair_mesh(PolygonMesh& mesh, const RepairOptions& options) {
     bool inconsistent = false;
     for (size_t e = 0; e < table.edges.size(); ++e) {
       const auto uses = table.uses(e);
-      if (uses.size() == 2 && uses[0].forward == uses[1].forward) inconsistent = true;
+      if (uses.size() == 2 && uses[0].forward == uses[1].forward) {
+        inconsistent = true;
+      }
       // An edge used by more faces is consistent only if its uses alternate; leave that to
       // validation.
     }
@@ -612,7 +681,9 @@ void require_valid_manifold(const PolygonMesh& mesh, const std::string& name,
                             const ManifoldRequirements& requirements) {
   const MeshValidation v = validate_mesh(mesh, requirements.validation);
   auto fail = [&](const std::string& problem) { throw InvalidInputError(name, problem); };
-  if (mesh.num_faces() == 0) fail("the mesh has no faces");
+  if (mesh.num_faces() == 0) {
+    fail("the mesh has no faces");
+  }
   if (v.malformed_faces.count) {
     fail(finding_text(v.malformed_faces,
                       "malformed faces (< 3 corners or vertex index out of range)"));

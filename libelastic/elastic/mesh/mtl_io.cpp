@@ -24,10 +24,14 @@ std::string_view texture_file(std::string_view rest) {
       std::string_view look = rest;
       const std::string_view arg = next_token(look);
       double number = 0.0;
-      if (arg.empty()) break;
+      if (arg.empty()) {
+        break;
+      }
       if (parse_double(arg, number) || arg == "on" || arg == "off" || word_argument) {
         rest = look;
-        if (word_argument) break;
+        if (word_argument) {
+          break;
+        }
         continue;
       }
       break;
@@ -41,7 +45,9 @@ std::string_view texture_file(std::string_view rest) {
 
 bool read_mtl(const std::filesystem::path& path, std::vector<Material>& materials) {
   std::error_code ec;
-  if (!std::filesystem::is_regular_file(path, ec)) return false;
+  if (!std::filesystem::is_regular_file(path, ec)) {
+    return false;
+  }
   const std::string text = read_whole_file(path);
   LineScanner scanner(text, path);
   std::string_view line;
@@ -49,7 +55,9 @@ bool read_mtl(const std::filesystem::path& path, std::vector<Material>& material
   while (scanner.next(line)) {
     std::string_view rest = line;
     const std::string_view keyword = next_token(rest);
-    if (keyword.empty() || keyword.front() == '#') continue;
+    if (keyword.empty() || keyword.front() == '#') {
+      continue;
+    }
     if (keyword == "newmtl") {
       materials.emplace_back();
       current = &materials.back();
@@ -58,11 +66,17 @@ bool read_mtl(const std::filesystem::path& path, std::vector<Material>& material
       continue;  // statements before the first newmtl belong to no material
     } else if (keyword == "Kd") {
       std::string_view probe = rest;
-      if (next_token(probe) == "spectral" || trim(rest).starts_with("xyz")) continue;
-      for (int k = 0; k < 3; ++k) current->diffuse[k] = expect_double(rest, scanner, "Kd value");
+      if (next_token(probe) == "spectral" || trim(rest).starts_with("xyz")) {
+        continue;
+      }
+      for (int k = 0; k < 3; ++k) {
+        current->diffuse[k] = expect_double(rest, scanner, "Kd value");
+      }
     } else if (keyword == "map_Kd") {
       std::string file(texture_file(rest));
-      if (file.empty()) scanner.fail("map_Kd without a file name");
+      if (file.empty()) {
+        scanner.fail("map_Kd without a file name");
+      }
       std::replace(file.begin(), file.end(), '\\', '/');
       const std::filesystem::path texture(file);
       current->diffuse_texture =
@@ -87,7 +101,9 @@ std::string write_mtl(const PolygonMesh& mesh, const std::filesystem::path& mtl_
       std::filesystem::path texture =
           std::filesystem::absolute(m.diffuse_texture).lexically_normal();
       const std::filesystem::path relative = texture.lexically_relative(folder);
-      if (!relative.empty()) texture = relative;
+      if (!relative.empty()) {
+        texture = relative;
+      }
       out += "map_Kd " + texture.generic_string() + "\n";
     }
   }

@@ -42,12 +42,17 @@ ObjTag parse_tag(std::string_view rest, const LineScanner& scanner) {
     if (!parse_int(part, n[k]) || n[k] < 0) {
       scanner.fail("cannot parse tag argument counts '" + std::string(counts) + "'");
     }
-    if (slash == std::string_view::npos) break;
+    if (slash == std::string_view::npos) {
+      break;
+    }
     c.remove_prefix(slash + 1);
   }
-  for (long long i = 0; i < n[0]; ++i) tag.ints.push_back(expect_int(rest, scanner, "tag integer"));
-  for (long long i = 0; i < n[1]; ++i)
+  for (long long i = 0; i < n[0]; ++i) {
+    tag.ints.push_back(expect_int(rest, scanner, "tag integer"));
+  }
+  for (long long i = 0; i < n[1]; ++i) {
     tag.floats.push_back(expect_double(rest, scanner, "tag value"));
+  }
   return tag;
 }
 
@@ -86,13 +91,17 @@ MeshReadResult read_obj(const std::string& text, const std::filesystem::path& pa
     if (!parse_int(token, i)) {
       scanner.fail(std::string("cannot parse ") + what + " index '" + std::string(token) + "'");
     }
-    if (i == 0) scanner.fail(std::string(what) + " index 0 (OBJ indices start at 1)");
+    if (i == 0) {
+      scanner.fail(std::string(what) + " index 0 (OBJ indices start at 1)");
+    }
     const long long zero_based = i > 0 ? i - 1 : static_cast<long long>(count) + i;
     if (zero_based < 0) {
       scanner.fail(std::string(what) + " index " + std::to_string(i) + " out of range (" +
                    std::to_string(count) + " defined so far)");
     }
-    if (zero_based > 2147483646LL) scanner.fail(std::string(what) + " index too large");
+    if (zero_based > 2147483646LL) {
+      scanner.fail(std::string(what) + " index too large");
+    }
     max_ref.note(zero_based, scanner.line_number());
     return static_cast<int>(zero_based);
   };
@@ -101,11 +110,17 @@ MeshReadResult read_obj(const std::string& text, const std::filesystem::path& pa
   while (scanner.next(line)) {
     std::string_view rest = line;
     const std::string_view keyword = next_token(rest);
-    if (keyword.empty() || keyword.front() == '#') continue;
+    if (keyword.empty() || keyword.front() == '#') {
+      continue;
+    }
     if (keyword == "v") {
       Eigen::Vector3d p;
-      for (int k = 0; k < 3; ++k) p[k] = expect_double(rest, scanner, "vertex coordinate");
-      if (!p.allFinite()) scanner.fail("vertex has a NaN or infinite coordinate");
+      for (int k = 0; k < 3; ++k) {
+        p[k] = expect_double(rest, scanner, "vertex coordinate");
+      }
+      if (!p.allFinite()) {
+        scanner.fail("vertex has a NaN or infinite coordinate");
+      }
       mesh.positions.push_back(p);
       // Optional: w (1 number) or a colour r g b (3 numbers, the common extension).
       double extra[4];
@@ -130,12 +145,18 @@ MeshReadResult read_obj(const std::string& text, const std::filesystem::path& pa
       if (!t.empty() && !parse_double(t, uv[1])) {
         scanner.fail("cannot parse texture coordinate '" + std::string(t) + "'");
       }
-      if (!uv.allFinite()) scanner.fail("texture coordinate is NaN or infinite");
+      if (!uv.allFinite()) {
+        scanner.fail("texture coordinate is NaN or infinite");
+      }
       mesh.texcoords.push_back(uv);
     } else if (keyword == "vn") {
       Eigen::Vector3d n;
-      for (int k = 0; k < 3; ++k) n[k] = expect_double(rest, scanner, "normal coordinate");
-      if (!n.allFinite()) scanner.fail("normal is NaN or infinite");
+      for (int k = 0; k < 3; ++k) {
+        n[k] = expect_double(rest, scanner, "normal coordinate");
+      }
+      if (!n.allFinite()) {
+        scanner.fail("normal is NaN or infinite");
+      }
       mesh.normals.push_back(n);
     } else if (keyword == "f") {
       int corners = 0;
@@ -149,10 +170,14 @@ MeshReadResult read_obj(const std::string& text, const std::filesystem::path& pa
           std::string_view tail = corner.substr(s1 + 1);
           const size_t s2 = tail.find('/');
           const std::string_view uvtok = tail.substr(0, s2);
-          if (!uvtok.empty()) uv = resolve(uvtok, mesh.texcoords.size(), max_vt, "texture");
+          if (!uvtok.empty()) {
+            uv = resolve(uvtok, mesh.texcoords.size(), max_vt, "texture");
+          }
           if (s2 != std::string_view::npos) {
             const std::string_view ntok = tail.substr(s2 + 1);
-            if (!ntok.empty()) normal = resolve(ntok, mesh.normals.size(), max_vn, "normal");
+            if (!ntok.empty()) {
+              normal = resolve(ntok, mesh.normals.size(), max_vn, "normal");
+            }
           }
         }
         corners_without_uv = corners_without_uv || uv < 0;
@@ -161,12 +186,15 @@ MeshReadResult read_obj(const std::string& text, const std::filesystem::path& pa
         corner_normal.push_back(normal);
         ++corners;
       }
-      if (corners < 3)
+      if (corners < 3) {
         scanner.fail("face with " + std::to_string(corners) + " corners (at least 3)");
+      }
       mesh.face_offsets.push_back(static_cast<int>(mesh.face_vertices.size()));
       face_materials.push_back(current_material);
     } else if (keyword == "mtllib") {
-      if (!options.load_materials) continue;
+      if (!options.load_materials) {
+        continue;
+      }
       const std::string_view names = trim(rest);
       std::vector<std::string> files;
       // A name with spaces is written as is; several names are separated by spaces.
@@ -187,7 +215,9 @@ MeshReadResult read_obj(const std::string& text, const std::filesystem::path& pa
                                     mtl.string() + " not found; materials ignored");
           continue;
         }
-        for (const Material& m : materials) add_material(m);
+        for (const Material& m : materials) {
+          add_material(m);
+        }
       }
     } else if (keyword == "usemtl") {
       const std::string name(trim(rest));
@@ -205,14 +235,18 @@ MeshReadResult read_obj(const std::string& text, const std::filesystem::path& pa
     } else if (keyword == "t") {
       const ObjTag tag = parse_tag(rest, scanner);
       auto sharpness = [&](size_t k) {
-        if (tag.floats.empty()) scanner.fail("tag '" + std::string(tag.name) + "' without a value");
+        if (tag.floats.empty()) {
+          scanner.fail("tag '" + std::string(tag.name) + "' without a value");
+        }
         return tag.floats.size() > 1 && k < tag.floats.size() ? tag.floats[k] : tag.floats[0];
       };
       if (tag.name == "crease") {
         // Vertex pairs (0-based, as OpenSubdiv writes them); one sharpness, or one per edge.
         for (size_t j = 0; j + 1 < tag.ints.size(); j += 2) {
           for (size_t k = j; k < j + 2; ++k) {
-            if (tag.ints[k] < 0) scanner.fail("negative vertex index in crease tag");
+            if (tag.ints[k] < 0) {
+              scanner.fail("negative vertex index in crease tag");
+            }
             max_tag.note(tag.ints[k], scanner.line_number());
           }
           mesh.creases.push_back(
@@ -220,7 +254,9 @@ MeshReadResult read_obj(const std::string& text, const std::filesystem::path& pa
         }
       } else if (tag.name == "corner") {
         for (size_t j = 0; j < tag.ints.size(); ++j) {
-          if (tag.ints[j] < 0) scanner.fail("negative vertex index in corner tag");
+          if (tag.ints[j] < 0) {
+            scanner.fail("negative vertex index in corner tag");
+          }
           max_tag.note(tag.ints[j], scanner.line_number());
           mesh.corners.emplace_back(static_cast<int>(tag.ints[j]), sharpness(j));
         }
@@ -250,14 +286,18 @@ MeshReadResult read_obj(const std::string& text, const std::filesystem::path& pa
                            std::to_string(max_tag.index) + " out of range (" +
                            std::to_string(mesh.positions.size()) + " vertices, tags count from 0)");
   }
-  if (mesh.face_offsets.size() == 1) mesh.face_offsets.clear();
+  if (mesh.face_offsets.size() == 1) {
+    mesh.face_offsets.clear();
+  }
 
   // Per-corner attributes are all-or-nothing in PolygonMesh: corners the file left without one
   // point at an added neutral entry.
   auto finish_corners = [&](std::vector<int>& corners, bool missing, auto& pool,
                             const auto& neutral, std::vector<int>& out, const char* what) {
     bool any = false;
-    for (int i : corners) any = any || i >= 0;
+    for (int i : corners) {
+      any = any || i >= 0;
+    }
     if (!any) {
       pool.clear();
       return;
@@ -266,7 +306,9 @@ MeshReadResult read_obj(const std::string& text, const std::filesystem::path& pa
       const int fill = static_cast<int>(pool.size());
       pool.push_back(neutral);
       for (int& i : corners) {
-        if (i < 0) i = fill;
+        if (i < 0) {
+          i = fill;
+        }
       }
       result.warnings.push_back(path.string() + ": some face corners have no " + what +
                                 "; they were given a default one");
@@ -286,7 +328,9 @@ MeshReadResult read_obj(const std::string& text, const std::filesystem::path& pa
                               " of " + std::to_string(mesh.positions.size()) +
                               " vertices have a colour; colours ignored");
   }
-  if (any_usemtl) mesh.face_materials = std::move(face_materials);
+  if (any_usemtl) {
+    mesh.face_materials = std::move(face_materials);
+  }
   if (skipped_elements > 0) {
     result.warnings.push_back(path.string() + ": skipped " + std::to_string(skipped_elements) +
                               " line/point elements (l, p)");
@@ -302,7 +346,9 @@ std::string write_obj(const PolygonMesh& mesh, const MeshWriteOptions& options,
   std::string out;
   out.reserve(mesh.positions.size() * 60 + mesh.face_vertices.size() * 16 + 64);
   out += "# written by libelastic\n";
-  if (!mtl_file_name.empty()) out += "mtllib " + mtl_file_name + "\n";
+  if (!mtl_file_name.empty()) {
+    out += "mtllib " + mtl_file_name + "\n";
+  }
   const bool colors = options.vertex_colors && mesh.has_vertex_colors();
   for (size_t v = 0; v < mesh.positions.size(); ++v) {
     const Eigen::Vector3d& p = mesh.positions[v];
@@ -359,7 +405,9 @@ std::string write_obj(const PolygonMesh& mesh, const MeshWriteOptions& options,
       append_number(out, mesh.face_vertices[static_cast<size_t>(c)] + 1);
       if (uv || normals) {
         out += '/';
-        if (uv) append_number(out, mesh.corner_texcoords[static_cast<size_t>(c)] + 1);
+        if (uv) {
+          append_number(out, mesh.corner_texcoords[static_cast<size_t>(c)] + 1);
+        }
         if (normals) {
           out += '/';
           append_number(out, mesh.corner_normals[static_cast<size_t>(c)] + 1);

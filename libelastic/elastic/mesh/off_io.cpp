@@ -20,7 +20,9 @@ bool next_content_line(LineScanner& scanner, std::string_view& content) {
   std::string_view line;
   while (scanner.next(line)) {
     content = trim(strip_comment(line));
-    if (!content.empty()) return true;
+    if (!content.empty()) {
+      return true;
+    }
   }
   return false;
 }
@@ -41,8 +43,9 @@ MeshReadResult read_off(const std::string& text, const std::filesystem::path& pa
   }
   std::string_view rest = content;
   std::string_view keyword = next_token(rest);
-  if (!keyword.ends_with("OFF"))
+  if (!keyword.ends_with("OFF")) {
     scanner.fail("expected an OFF header, found '" + std::string(keyword) + "'");
+  }
   std::string_view prefix = keyword.substr(0, keyword.size() - 3);
   bool has_uv = false;
   bool has_color = false;
@@ -63,7 +66,9 @@ MeshReadResult read_off(const std::string& text, const std::filesystem::path& pa
     scanner.fail("unsupported OFF variant '" + std::string(keyword) +
                  "' (4OFF / nOFF are not read)");
   }
-  if (trim(rest) == "BINARY") scanner.fail("binary OFF is not supported");
+  if (trim(rest) == "BINARY") {
+    scanner.fail("binary OFF is not supported");
+  }
   if (trim(rest).empty()) {
     if (!next_content_line(scanner, content)) {
       throw InvalidInputError(path.string(),
@@ -73,11 +78,15 @@ MeshReadResult read_off(const std::string& text, const std::filesystem::path& pa
   }
   const long long nv = expect_int(rest, scanner, "vertex count");
   const long long nf = expect_int(rest, scanner, "face count");
-  if (nv < 0 || nf < 0 || nv > 2147483647LL || nf > 2147483647LL) scanner.fail("invalid counts");
+  if (nv < 0 || nf < 0 || nv > 2147483647LL || nf > 2147483647LL) {
+    scanner.fail("invalid counts");
+  }
   // Counts come from the file: reserve no more than its size could hold.
   const auto bound = static_cast<long long>(text.size() / 6 + 1);
   mesh.positions.reserve(static_cast<size_t>(std::min(nv, bound)));
-  if (has_color) mesh.vertex_colors.reserve(static_cast<size_t>(std::min(nv, bound)));
+  if (has_color) {
+    mesh.vertex_colors.reserve(static_cast<size_t>(std::min(nv, bound)));
+  }
 
   std::vector<double> values;
   for (long long v = 0; v < nv; ++v) {
@@ -87,18 +96,25 @@ MeshReadResult read_off(const std::string& text, const std::filesystem::path& pa
     }
     rest = content;
     Eigen::Vector3d p;
-    for (int k = 0; k < 3; ++k) p[k] = expect_double(rest, scanner, "vertex coordinate");
-    if (!p.allFinite()) scanner.fail("vertex has a NaN or infinite coordinate");
+    for (int k = 0; k < 3; ++k) {
+      p[k] = expect_double(rest, scanner, "vertex coordinate");
+    }
+    if (!p.allFinite()) {
+      scanner.fail("vertex has a NaN or infinite coordinate");
+    }
     mesh.positions.push_back(p);
     if (has_normal) {
       Eigen::Vector3d n;
-      for (int k = 0; k < 3; ++k) n[k] = expect_double(rest, scanner, "normal coordinate");
+      for (int k = 0; k < 3; ++k) {
+        n[k] = expect_double(rest, scanner, "normal coordinate");
+      }
       mesh.normals.push_back(n);
     }
     // The rest: colour (3 or 4 values, integers 0..255 or reals 0..1), then s t when ST.
     std::vector<std::string_view> tokens;
-    for (std::string_view t = next_token(rest); !t.empty(); t = next_token(rest))
+    for (std::string_view t = next_token(rest); !t.empty(); t = next_token(rest)) {
       tokens.push_back(t);
+    }
     values.resize(tokens.size());
     for (size_t i = 0; i < tokens.size(); ++i) {
       if (!parse_double(tokens[i], values[i])) {
@@ -107,12 +123,16 @@ MeshReadResult read_off(const std::string& text, const std::filesystem::path& pa
     }
     size_t uv_at = tokens.size();
     if (has_uv) {
-      if (tokens.size() < 2) scanner.fail("missing texture coordinates");
+      if (tokens.size() < 2) {
+        scanner.fail("missing texture coordinates");
+      }
       uv_at = tokens.size() - 2;
       mesh.texcoords.emplace_back(values[uv_at], values[uv_at + 1]);
     }
     if (has_color) {
-      if (uv_at < 3) scanner.fail("missing vertex colour");
+      if (uv_at < 3) {
+        scanner.fail("missing vertex colour");
+      }
       const bool bytes =
           looks_integer(tokens[0]) && looks_integer(tokens[1]) && looks_integer(tokens[2]);
       const double scale = bytes ? 1.0 / 255.0 : 1.0;
@@ -131,7 +151,9 @@ MeshReadResult read_off(const std::string& text, const std::filesystem::path& pa
     }
     rest = content;
     const long long n = expect_int(rest, scanner, "face size");
-    if (n < 3) scanner.fail("face with " + std::to_string(n) + " corners (at least 3)");
+    if (n < 3) {
+      scanner.fail("face with " + std::to_string(n) + " corners (at least 3)");
+    }
     for (long long k = 0; k < n; ++k) {
       const long long i = expect_int(rest, scanner, "face vertex index");
       if (i < 0 || i >= nv) {
@@ -143,10 +165,16 @@ MeshReadResult read_off(const std::string& text, const std::filesystem::path& pa
     // Anything after the indices is a face colour: not used.
     mesh.face_offsets.push_back(static_cast<int>(mesh.face_vertices.size()));
   }
-  if (mesh.face_offsets.size() == 1) mesh.face_offsets.clear();
+  if (mesh.face_offsets.size() == 1) {
+    mesh.face_offsets.clear();
+  }
   // Per-vertex attributes become per-corner ones indexing a per-vertex pool.
-  if (has_uv) mesh.corner_texcoords = mesh.face_vertices;
-  if (has_normal) mesh.corner_normals = mesh.face_vertices;
+  if (has_uv) {
+    mesh.corner_texcoords = mesh.face_vertices;
+  }
+  if (has_normal) {
+    mesh.corner_normals = mesh.face_vertices;
+  }
   return result;
 }
 
@@ -159,7 +187,9 @@ std::string write_off(const PolygonMesh& mesh, const MeshWriteOptions& options) 
   out += " 0\n";
   for (size_t v = 0; v < mesh.positions.size(); ++v) {
     for (int k = 0; k < 3; ++k) {
-      if (k) out += ' ';
+      if (k) {
+        out += ' ';
+      }
       append_number(out, mesh.positions[v][k]);
     }
     if (colors) {

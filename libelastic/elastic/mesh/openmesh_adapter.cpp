@@ -67,14 +67,17 @@ HalfedgeMesh to_openmesh(const PolygonMesh& mesh, const ToOpenMeshOptions& optio
   HalfedgeMesh out;
   out.reserve(static_cast<size_t>(mesh.num_vertices()), mesh.face_vertices.size(),
               static_cast<size_t>(mesh.num_faces()));
-  for (const Eigen::Vector3d& p : mesh.positions)
+  for (const Eigen::Vector3d& p : mesh.positions) {
     out.add_vertex(HalfedgeMesh::Point(p.x(), p.y(), p.z()));
+  }
 
   const bool uv = options.texcoords && mesh.has_texcoords();
   std::vector<HalfedgeMesh::VertexHandle> corners;
   for (int f = 0; f < mesh.num_faces(); ++f) {
     corners.clear();
-    for (int i : mesh.face(f)) corners.push_back(out.vertex_handle(static_cast<unsigned>(i)));
+    for (int i : mesh.face(f)) {
+      corners.push_back(out.vertex_handle(static_cast<unsigned>(i)));
+    }
     const HalfedgeMesh::FaceHandle fh = out.add_face(corners);
     if (!fh.is_valid()) {
       // Validation guarantees manifoldness; this is a safety net, not an expected path.
@@ -84,7 +87,9 @@ HalfedgeMesh to_openmesh(const PolygonMesh& mesh, const ToOpenMeshOptions& optio
     const size_t n = corners.size();
     for (size_t k = 0; k < n; ++k) {
       const auto h = out.find_halfedge(corners[(k + n - 1) % n], corners[k]);
-      if (k == 0) out.set_halfedge_handle(fh, h);
+      if (k == 0) {
+        out.set_halfedge_handle(fh, h);
+      }
       if (uv) {
         const int corner = mesh.face_offsets[static_cast<size_t>(f)] + static_cast<int>(k);
         const Eigen::Vector2d& t =
@@ -93,7 +98,9 @@ HalfedgeMesh to_openmesh(const PolygonMesh& mesh, const ToOpenMeshOptions& optio
       }
     }
   }
-  if (options.compute_normals) out.update_normals();
+  if (options.compute_normals) {
+    out.update_normals();
+  }
   return out;
 }
 
@@ -116,7 +123,9 @@ PolygonMesh from_openmesh(const HalfedgeMesh& mesh, const FromOpenMeshOptions& o
         const auto& t = mesh.texcoord2D(h);
         const auto [it, inserted] =
             uv_index.try_emplace({t[0], t[1]}, static_cast<int>(out.texcoords.size()));
-        if (inserted) out.texcoords.emplace_back(t[0], t[1]);
+        if (inserted) {
+          out.texcoords.emplace_back(t[0], t[1]);
+        }
         out.corner_texcoords.push_back(it->second);
       }
     }

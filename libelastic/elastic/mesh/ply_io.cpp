@@ -100,7 +100,9 @@ class PlyData {
   }
 
   double read(PlyType type) {
-    if (encoding_ == PlyEncoding::Ascii) return read_ascii();
+    if (encoding_ == PlyEncoding::Ascii) {
+      return read_ascii();
+    }
     const size_t size = type_size(type);
     if (pos_ + size > data_.size()) {
       fail("truncated file: the binary data ends in element '" + *element_ + "' row " +
@@ -111,7 +113,9 @@ class PlyData {
     pos_ += size;
     const bool swap =
         (encoding_ == PlyEncoding::BinaryBig) != (std::endian::native == std::endian::big);
-    if (swap) std::reverse(bytes, bytes + size);
+    if (swap) {
+      std::reverse(bytes, bytes + size);
+    }
     switch (type) {
       case PlyType::Int8:
         return static_cast<double>(static_cast<signed char>(bytes[0]));
@@ -150,7 +154,9 @@ class PlyData {
 
   double read_ascii() {
     while (pos_ < data_.size() && (is_space(data_[pos_]) || data_[pos_] == '\n')) {
-      if (data_[pos_] == '\n') ++line_;
+      if (data_[pos_] == '\n') {
+        ++line_;
+      }
       ++pos_;
     }
     if (pos_ >= data_.size()) {
@@ -158,11 +164,15 @@ class PlyData {
            std::to_string(row_ + 1) + " of " + std::to_string(rows_));
     }
     size_t end = pos_;
-    while (end < data_.size() && !is_space(data_[end]) && data_[end] != '\n') ++end;
+    while (end < data_.size() && !is_space(data_[end]) && data_[end] != '\n') {
+      ++end;
+    }
     const std::string_view token = data_.substr(pos_, end - pos_);
     pos_ = end;
     double value = 0.0;
-    if (!parse_double(token, value)) fail("cannot parse number '" + std::string(token) + "'");
+    if (!parse_double(token, value)) {
+      fail("cannot parse number '" + std::string(token) + "'");
+    }
     return value;
   }
 
@@ -201,7 +211,9 @@ int vertex_role(std::string_view name) {
                                                            {"texture_s", kU},
                                                            {"texture_t", kV}};
   for (const auto& [n, r] : roles) {
-    if (n == name) return r;
+    if (n == name) {
+      return r;
+    }
   }
   return kSkip;
 }
@@ -213,7 +225,9 @@ MeshReadResult read_ply(const std::string& text, const std::filesystem::path& pa
   PolygonMesh& mesh = result.mesh;
   LineScanner scanner(text, path);
   std::string_view line;
-  if (!scanner.next(line) || trim(line) != "ply") scanner.fail("not a PLY file (no 'ply' magic)");
+  if (!scanner.next(line) || trim(line) != "ply") {
+    scanner.fail("not a PLY file (no 'ply' magic)");
+  }
 
   PlyEncoding encoding = PlyEncoding::Ascii;
   bool have_format = false;
@@ -222,7 +236,9 @@ MeshReadResult read_ply(const std::string& text, const std::filesystem::path& pa
   while (scanner.next(line)) {
     std::string_view rest = line;
     const std::string_view keyword = next_token(rest);
-    if (keyword.empty() || keyword == "comment" || keyword == "obj_info") continue;
+    if (keyword.empty() || keyword == "comment" || keyword == "obj_info") {
+      continue;
+    }
     if (keyword == "end_header") {
       ended = true;
       break;
@@ -243,10 +259,14 @@ MeshReadResult read_ply(const std::string& text, const std::filesystem::path& pa
       PlyElement element;
       element.name = std::string(next_token(rest));
       element.count = expect_int(rest, scanner, "element count");
-      if (element.name.empty() || element.count < 0) scanner.fail("invalid element declaration");
+      if (element.name.empty() || element.count < 0) {
+        scanner.fail("invalid element declaration");
+      }
       elements.push_back(std::move(element));
     } else if (keyword == "property") {
-      if (elements.empty()) scanner.fail("property before any element");
+      if (elements.empty()) {
+        scanner.fail("property before any element");
+      }
       PlyProperty property;
       std::string_view type = next_token(rest);
       if (type == "list") {
@@ -257,17 +277,24 @@ MeshReadResult read_ply(const std::string& text, const std::filesystem::path& pa
         }
         type = next_token(rest);
       }
-      if (!parse_type(type, property.type))
+      if (!parse_type(type, property.type)) {
         scanner.fail("unknown property type '" + std::string(type) + "'");
+      }
       property.name = std::string(next_token(rest));
-      if (property.name.empty()) scanner.fail("property without a name");
+      if (property.name.empty()) {
+        scanner.fail("property without a name");
+      }
       elements.back().properties.push_back(std::move(property));
     } else {
       scanner.fail("unknown header keyword '" + std::string(keyword) + "'");
     }
   }
-  if (!ended) throw InvalidInputError(path.string(), "truncated file: no end_header");
-  if (!have_format) throw InvalidInputError(path.string(), "no format line in the PLY header");
+  if (!ended) {
+    throw InvalidInputError(path.string(), "truncated file: no end_header");
+  }
+  if (!have_format) {
+    throw InvalidInputError(path.string(), "no format line in the PLY header");
+  }
 
   PlyData data(std::string_view(text).substr(scanner.position()), encoding, path,
                scanner.line_number() + 1);
@@ -292,7 +319,9 @@ MeshReadResult read_ply(const std::string& text, const std::filesystem::path& pa
         role[p] = property.is_list ? kSkip : vertex_role(property.name);
         if (role[p] != kSkip) {
           has_role[role[p]] = true;
-          if (role[p] >= kRed && role[p] <= kBlue) scale[role[p]] = color_scale(property.type);
+          if (role[p] >= kRed && role[p] <= kBlue) {
+            scale[role[p]] = color_scale(property.type);
+          }
         }
       }
       if (!has_role[kX] || !has_role[kY] || !has_role[kZ]) {
@@ -311,31 +340,41 @@ MeshReadResult read_ply(const std::string& text, const std::filesystem::path& pa
           const PlyProperty& property = element.properties[p];
           if (property.is_list) {
             const double n = data.read(property.count_type);
-            for (long long k = 0; k < static_cast<long long>(n); ++k) data.read(property.type);
+            for (long long k = 0; k < static_cast<long long>(n); ++k) {
+              data.read(property.type);
+            }
             continue;
           }
           const double value = data.read(property.type);
-          if (role[p] != kSkip) values[role[p]] = value;
+          if (role[p] != kSkip) {
+            values[role[p]] = value;
+          }
         }
         const Eigen::Vector3d position(values[kX], values[kY], values[kZ]);
         if (!position.allFinite()) {
           data.fail("vertex " + std::to_string(row) + " has a NaN or infinite coordinate");
         }
         mesh.positions.push_back(position);
-        if (have_normal) mesh.normals.emplace_back(values[kNx], values[kNy], values[kNz]);
+        if (have_normal) {
+          mesh.normals.emplace_back(values[kNx], values[kNy], values[kNz]);
+        }
         if (have_color) {
           mesh.vertex_colors.emplace_back(static_cast<float>(values[kRed] * scale[kRed]),
                                           static_cast<float>(values[kGreen] * scale[kGreen]),
                                           static_cast<float>(values[kBlue] * scale[kBlue]));
         }
-        if (have_uv) mesh.texcoords.emplace_back(values[kU], values[kV]);
+        if (have_uv) {
+          mesh.texcoords.emplace_back(values[kU], values[kV]);
+        }
       }
     } else if (element.name == "face" && mesh.face_offsets.empty()) {
       int indices_property = -1;
       int texcoord_property = -1;
       for (size_t p = 0; p < element.properties.size(); ++p) {
         const PlyProperty& property = element.properties[p];
-        if (!property.is_list) continue;
+        if (!property.is_list) {
+          continue;
+        }
         if (indices_property < 0 &&
             (property.name == "vertex_indices" || property.name == "vertex_index")) {
           indices_property = static_cast<int>(p);
@@ -354,10 +393,18 @@ MeshReadResult read_ply(const std::string& text, const std::filesystem::path& pa
       std::array<int, 3> face_color_property{-1, -1, -1};
       for (size_t p = 0; p < element.properties.size(); ++p) {
         const PlyProperty& property = element.properties[p];
-        if (property.is_list) continue;
-        if (property.name == "red") face_color_property[0] = static_cast<int>(p);
-        if (property.name == "green") face_color_property[1] = static_cast<int>(p);
-        if (property.name == "blue") face_color_property[2] = static_cast<int>(p);
+        if (property.is_list) {
+          continue;
+        }
+        if (property.name == "red") {
+          face_color_property[0] = static_cast<int>(p);
+        }
+        if (property.name == "green") {
+          face_color_property[1] = static_cast<int>(p);
+        }
+        if (property.name == "blue") {
+          face_color_property[2] = static_cast<int>(p);
+        }
       }
       const bool have_face_color =
           face_color_property[0] >= 0 && face_color_property[1] >= 0 && face_color_property[2] >= 0;
@@ -378,13 +425,16 @@ MeshReadResult read_ply(const std::string& text, const std::filesystem::path& pa
             continue;
           }
           const double count = data.read(property.count_type);
-          if (count < 0) data.fail("negative list length in face " + std::to_string(row));
+          if (count < 0) {
+            data.fail("negative list length in face " + std::to_string(row));
+          }
           const auto n = static_cast<long long>(count);
           if (static_cast<int>(p) == indices_property) {
             corners = n;
-            if (n < 3)
+            if (n < 3) {
               data.fail("face " + std::to_string(row) + " has " + std::to_string(n) +
                         " corners (at least 3)");
+            }
             for (long long k = 0; k < n; ++k) {
               const double i = data.read(property.type);
               if (!(i >= 0 && i < static_cast<double>(num_vertices)) || !seen_vertices) {
@@ -396,9 +446,13 @@ MeshReadResult read_ply(const std::string& text, const std::filesystem::path& pa
             }
           } else if (static_cast<int>(p) == texcoord_property) {
             uv_values.clear();
-            for (long long k = 0; k < n; ++k) uv_values.push_back(data.read(property.type));
+            for (long long k = 0; k < n; ++k) {
+              uv_values.push_back(data.read(property.type));
+            }
           } else {
-            for (long long k = 0; k < n; ++k) data.read(property.type);
+            for (long long k = 0; k < n; ++k) {
+              data.read(property.type);
+            }
           }
         }
         if (have_corner_uv) {
@@ -414,10 +468,14 @@ MeshReadResult read_ply(const std::string& text, const std::filesystem::path& pa
             result.mesh.texcoords.emplace_back(uv_values[k], uv_values[k + 1]);
           }
         }
-        if (have_face_color) mesh.face_colors.push_back(face_color);
+        if (have_face_color) {
+          mesh.face_colors.push_back(face_color);
+        }
         mesh.face_offsets.push_back(static_cast<int>(mesh.face_vertices.size()));
       }
-      if (mesh.face_offsets.size() == 1) mesh.face_offsets.clear();
+      if (mesh.face_offsets.size() == 1) {
+        mesh.face_offsets.clear();
+      }
     } else {
       // Skip other elements (edges, materials, a second vertex element...) by their declared types.
       for (long long row = 0; row < element.count; ++row) {
@@ -425,7 +483,9 @@ MeshReadResult read_ply(const std::string& text, const std::filesystem::path& pa
         for (const PlyProperty& property : element.properties) {
           const long long n =
               property.is_list ? static_cast<long long>(data.read(property.count_type)) : 1;
-          for (long long k = 0; k < n; ++k) data.read(property.type);
+          for (long long k = 0; k < n; ++k) {
+            data.read(property.type);
+          }
         }
       }
     }
@@ -440,7 +500,9 @@ MeshReadResult read_ply(const std::string& text, const std::filesystem::path& pa
   } else if (have_uv) {
     mesh.corner_texcoords = mesh.face_vertices;
   }
-  if (have_normal) mesh.corner_normals = mesh.face_vertices;
+  if (have_normal) {
+    mesh.corner_normals = mesh.face_vertices;
+  }
   return result;
 }
 
@@ -495,7 +557,9 @@ class PlyWriter {
     }
   }
   void end_row() {
-    if (!binary_) out += '\n';
+    if (!binary_) {
+      out += '\n';
+    }
     first_ = true;
   }
   std::string out;
@@ -505,11 +569,15 @@ class PlyWriter {
   void raw(T value) {
     char bytes[sizeof(T)];
     std::memcpy(bytes, &value, sizeof(T));
-    if constexpr (std::endian::native == std::endian::big) std::reverse(bytes, bytes + sizeof(T));
+    if constexpr (std::endian::native == std::endian::big) {
+      std::reverse(bytes, bytes + sizeof(T));
+    }
     out.append(bytes, sizeof(T));
   }
   void separate() {
-    if (!first_) out += ' ';
+    if (!first_) {
+      out += ' ';
+    }
     first_ = false;
   }
   bool binary_;
@@ -531,7 +599,9 @@ std::string write_ply(const PolygonMesh& mesh, const MeshWriteOptions& options) 
   const bool face_colors = options.face_colors && mesh.has_face_colors() &&
                            mesh.face_colors.size() == static_cast<size_t>(mesh.num_faces());
   int max_face = 0;
-  for (int f = 0; f < mesh.num_faces(); ++f) max_face = std::max(max_face, mesh.face_size(f));
+  for (int f = 0; f < mesh.num_faces(); ++f) {
+    max_face = std::max(max_face, mesh.face_size(f));
+  }
   // List lengths are uchar when they fit, as most readers expect.
   const bool byte_counts = max_face <= 127;
 
@@ -542,14 +612,24 @@ std::string write_ply(const PolygonMesh& mesh, const MeshWriteOptions& options) 
   out +=
       "comment written by libelastic\nelement vertex " + std::to_string(mesh.num_vertices()) + "\n";
   out += "property double x\nproperty double y\nproperty double z\n";
-  if (normals) out += "property double nx\nproperty double ny\nproperty double nz\n";
-  if (colors) out += "property uchar red\nproperty uchar green\nproperty uchar blue\n";
-  if (vertex_uv) out += "property double u\nproperty double v\n";
+  if (normals) {
+    out += "property double nx\nproperty double ny\nproperty double nz\n";
+  }
+  if (colors) {
+    out += "property uchar red\nproperty uchar green\nproperty uchar blue\n";
+  }
+  if (vertex_uv) {
+    out += "property double u\nproperty double v\n";
+  }
   out += "element face " + std::to_string(mesh.num_faces()) + "\n";
   const char* count_type = byte_counts ? "uchar" : "int";
   out += std::string("property list ") + count_type + " int vertex_indices\n";
-  if (corner_uv) out += std::string("property list ") + count_type + " double texcoord\n";
-  if (face_colors) out += "property uchar red\nproperty uchar green\nproperty uchar blue\n";
+  if (corner_uv) {
+    out += std::string("property list ") + count_type + " double texcoord\n";
+  }
+  if (face_colors) {
+    out += "property uchar red\nproperty uchar green\nproperty uchar blue\n";
+  }
   out += "end_header\n";
   auto count = [&](int n) {
     if (byte_counts) {
@@ -559,12 +639,18 @@ std::string write_ply(const PolygonMesh& mesh, const MeshWriteOptions& options) 
     }
   };
   for (size_t v = 0; v < mesh.positions.size(); ++v) {
-    for (int k = 0; k < 3; ++k) w.real(mesh.positions[v][k]);
+    for (int k = 0; k < 3; ++k) {
+      w.real(mesh.positions[v][k]);
+    }
     if (normals) {
-      for (int k = 0; k < 3; ++k) w.real(vertex_normals[v][k]);
+      for (int k = 0; k < 3; ++k) {
+        w.real(vertex_normals[v][k]);
+      }
     }
     if (colors) {
-      for (int k = 0; k < 3; ++k) w.byte(to_byte(mesh.vertex_colors[v][k]));
+      for (int k = 0; k < 3; ++k) {
+        w.byte(to_byte(mesh.vertex_colors[v][k]));
+      }
     }
     if (vertex_uv) {
       w.real(vertex_uvs[v][0]);
@@ -574,7 +660,9 @@ std::string write_ply(const PolygonMesh& mesh, const MeshWriteOptions& options) 
   }
   for (int f = 0; f < mesh.num_faces(); ++f) {
     count(mesh.face_size(f));
-    for (int v : mesh.face(f)) w.integer(v);
+    for (int v : mesh.face(f)) {
+      w.integer(v);
+    }
     if (corner_uv) {
       count(2 * mesh.face_size(f));
       for (int c = mesh.face_offsets[static_cast<size_t>(f)];
@@ -586,7 +674,9 @@ std::string write_ply(const PolygonMesh& mesh, const MeshWriteOptions& options) 
       }
     }
     if (face_colors) {
-      for (int k = 0; k < 3; ++k) w.byte(to_byte(mesh.face_colors[static_cast<size_t>(f)][k]));
+      for (int k = 0; k < 3; ++k) {
+        w.byte(to_byte(mesh.face_colors[static_cast<size_t>(f)][k]));
+      }
     }
     w.end_row();
   }

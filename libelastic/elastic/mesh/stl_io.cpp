@@ -38,7 +38,9 @@ class Welder {
                           std::bit_cast<std::uint64_t>(p.y() + 0.0),
                           std::bit_cast<std::uint64_t>(p.z() + 0.0)};
     const auto [it, inserted] = index_.try_emplace(key, mesh_.num_vertices());
-    if (inserted) mesh_.positions.push_back(p);
+    if (inserted) {
+      mesh_.positions.push_back(p);
+    }
     return it->second;
   }
 
@@ -80,8 +82,9 @@ MeshReadResult read_binary_stl(const std::string& bytes, const std::filesystem::
     const char* record = bytes.data() + 84 + 50ULL * t;
     for (int corner = 0; corner < 3; ++corner) {
       Eigen::Vector3d p;
-      for (int k = 0; k < 3; ++k)
+      for (int k = 0; k < 3; ++k) {
         p[k] = static_cast<double>(read_f32_le(record + 12 + 12 * corner + 4 * k));
+      }
       if (!p.allFinite()) {
         throw InvalidInputError(
             path.string(), "triangle " + std::to_string(t) + " has a NaN or infinite coordinate");
@@ -90,7 +93,9 @@ MeshReadResult read_binary_stl(const std::string& bytes, const std::filesystem::
     }
     mesh.face_offsets.push_back(static_cast<int>(mesh.face_vertices.size()));
   }
-  if (mesh.face_offsets.size() == 1) mesh.face_offsets.clear();
+  if (mesh.face_offsets.size() == 1) {
+    mesh.face_offsets.clear();
+  }
   return result;
 }
 
@@ -107,20 +112,31 @@ MeshReadResult read_ascii_stl(const std::string& text, const std::filesystem::pa
   while (scanner.next(line)) {
     std::string_view rest = line;
     const std::string_view keyword = next_token(rest);
-    if (keyword.empty()) continue;
+    if (keyword.empty()) {
+      continue;
+    }
     if (keyword == "vertex") {
-      if (!in_loop) scanner.fail("vertex outside 'outer loop'");
+      if (!in_loop) {
+        scanner.fail("vertex outside 'outer loop'");
+      }
       Eigen::Vector3d p;
-      for (int k = 0; k < 3; ++k) p[k] = expect_double(rest, scanner, "vertex coordinate");
-      if (!p.allFinite()) scanner.fail("vertex has a NaN or infinite coordinate");
+      for (int k = 0; k < 3; ++k) {
+        p[k] = expect_double(rest, scanner, "vertex coordinate");
+      }
+      if (!p.allFinite()) {
+        scanner.fail("vertex has a NaN or infinite coordinate");
+      }
       loop.push_back(welder.vertex(p));
     } else if (keyword == "outer") {
       in_loop = true;
       loop.clear();
     } else if (keyword == "endloop") {
-      if (!in_loop) scanner.fail("'endloop' without 'outer loop'");
-      if (loop.size() < 3)
+      if (!in_loop) {
+        scanner.fail("'endloop' without 'outer loop'");
+      }
+      if (loop.size() < 3) {
         scanner.fail("facet with " + std::to_string(loop.size()) + " vertices (at least 3)");
+      }
       mesh.face_vertices.insert(mesh.face_vertices.end(), loop.begin(), loop.end());
       mesh.face_offsets.push_back(static_cast<int>(mesh.face_vertices.size()));
       in_loop = false;
@@ -133,7 +149,9 @@ MeshReadResult read_ascii_stl(const std::string& text, const std::filesystem::pa
   if (in_loop || !ended) {
     throw InvalidInputError(path.string(), "truncated file: it ends before 'endsolid'");
   }
-  if (mesh.face_offsets.size() == 1) mesh.face_offsets.clear();
+  if (mesh.face_offsets.size() == 1) {
+    mesh.face_offsets.clear();
+  }
   return result;
 }
 
@@ -152,15 +170,21 @@ MeshReadResult read_stl(const std::string& text, const std::filesystem::path& pa
   // (some binary writers start their header with "solid"); ASCII when it starts with "solid".
   if (text.size() >= 84) {
     const std::uint64_t n = read_u32_le(text.data() + 80);
-    if (84 + 50 * n == text.size()) return read_binary_stl(text, path);
+    if (84 + 50 * n == text.size()) {
+      return read_binary_stl(text, path);
+    }
   }
   std::string_view head(text.data(), std::min<size_t>(text.size(), 512));
   size_t i = 0;
-  while (i < head.size() && is_space(head[i])) ++i;
+  while (i < head.size() && is_space(head[i])) {
+    ++i;
+  }
   if (head.substr(i).starts_with("solid") && head.find("facet") != std::string_view::npos) {
     return read_ascii_stl(text, path);
   }
-  if (head.substr(i).starts_with("solid") && text.size() < 84) return read_ascii_stl(text, path);
+  if (head.substr(i).starts_with("solid") && text.size() < 84) {
+    return read_ascii_stl(text, path);
+  }
   if (text.size() < 84) {
     throw InvalidInputError(path.string(), "truncated file: " + std::to_string(text.size()) +
                                                " bytes, shorter than a binary STL header (84)");
@@ -171,8 +195,9 @@ MeshReadResult read_stl(const std::string& text, const std::filesystem::path& pa
 std::string write_stl(const PolygonMesh& mesh, const MeshWriteOptions& options) {
   // Polygons are split into a fan of triangles around their first corner.
   std::size_t triangles = 0;
-  for (int f = 0; f < mesh.num_faces(); ++f)
+  for (int f = 0; f < mesh.num_faces(); ++f) {
     triangles += static_cast<size_t>(mesh.face_size(f) - 2);
+  }
   std::string out;
   auto for_each_triangle = [&](auto&& emit) {
     for (int f = 0; f < mesh.num_faces(); ++f) {
@@ -185,13 +210,17 @@ std::string write_stl(const PolygonMesh& mesh, const MeshWriteOptions& options) 
     }
   };
   if (options.binary) {
-    if (triangles > 0xffffffffULL) throw InvalidInputError("", "too many triangles for binary STL");
+    if (triangles > 0xffffffffULL) {
+      throw InvalidInputError("", "too many triangles for binary STL");
+    }
     out.reserve(84 + 50 * triangles);
     std::string header = "binary STL written by libelastic";
     header.resize(80, ' ');
     out += header;
     auto u32 = [&](std::uint32_t v) {
-      for (int k = 0; k < 4; ++k) out += static_cast<char>((v >> (8 * k)) & 0xffu);
+      for (int k = 0; k < 4; ++k) {
+        out += static_cast<char>((v >> (8 * k)) & 0xffu);
+      }
     };
     auto f32 = [&](double v) { u32(std::bit_cast<std::uint32_t>(static_cast<float>(v))); };
     u32(static_cast<std::uint32_t>(triangles));
@@ -199,7 +228,9 @@ std::string write_stl(const PolygonMesh& mesh, const MeshWriteOptions& options) 
         [&](const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c) {
           const Eigen::Vector3d n = triangle_normal(a, b, c);
           for (const Eigen::Vector3d* p : {&n, &a, &b, &c}) {
-            for (int k = 0; k < 3; ++k) f32((*p)[k]);
+            for (int k = 0; k < 3; ++k) {
+              f32((*p)[k]);
+            }
           }
           out += '\0';
           out += '\0';

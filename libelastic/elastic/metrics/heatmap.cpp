@@ -73,12 +73,16 @@ HeatmapResult make_heatmap(const Eigen::Matrix3Xd& target_positions, const MapMe
   }
   // A map that is perfect everywhere has high == low: widen the range so that it shows all green
   // and any later deviation is visible on the same scale (1% of the perfect value, or 0.01).
-  if (!(out.high > out.low)) out.high = out.low + std::max(0.01, 0.01 * std::abs(out.low));
+  if (!(out.high > out.low)) {
+    out.high = out.low + std::max(0.01, 0.01 * std::abs(out.low));
+  }
 
   PolygonMesh& mesh = out.mesh;
   const int np = static_cast<int>(target_positions.cols());
   mesh.positions.resize(np);
-  for (int p = 0; p < np; ++p) mesh.positions[p] = target_positions.col(p);
+  for (int p = 0; p < np; ++p) {
+    mesh.positions[p] = target_positions.col(p);
+  }
   mesh.face_colors.reserve(nt);
   std::vector<Eigen::Vector3f> color_sum(np, Eigen::Vector3f::Zero());
   std::vector<int> color_count(np, 0);

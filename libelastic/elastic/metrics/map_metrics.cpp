@@ -31,7 +31,9 @@ constexpr std::array<MetricName, 7> kMetricNames{{
 
 const MetricName& lookup(TriangleMetric metric) {
   for (const auto& entry : kMetricNames) {
-    if (entry.metric == metric) return entry;
+    if (entry.metric == metric) {
+      return entry;
+    }
   }
   return kMetricNames[0];
 }
@@ -57,7 +59,9 @@ std::string_view to_string(TriangleMetric metric) {
 TriangleMetric parse_triangle_metric(std::string_view text, std::string_view input) {
   std::string known;
   for (const auto& entry : kMetricNames) {
-    if (entry.name == text) return entry.metric;
+    if (entry.name == text) {
+      return entry.metric;
+    }
     known += (known.empty() ? "" : ", ") + std::string(entry.name);
   }
   throw InvalidInputError(std::string(input), "unknown metric '" + std::string(text) +
@@ -71,7 +75,9 @@ double perfect_value(TriangleMetric metric) {
 const std::vector<TriangleMetric>& all_triangle_metrics() {
   static const std::vector<TriangleMetric> all = [] {
     std::vector<TriangleMetric> out;
-    for (const auto& entry : kMetricNames) out.push_back(entry.metric);
+    for (const auto& entry : kMetricNames) {
+      out.push_back(entry.metric);
+    }
     return out;
   }();
   return all;
@@ -106,7 +112,9 @@ std::vector<Eigen::Vector3i> grid_triangles(const ParticleGrid& grid) {
   std::vector<int> corners;
   for (const auto fh : grid.mesh.faces()) {
     corners.clear();
-    for (const auto vh : grid.mesh.fv_range(fh)) corners.push_back(vh.idx());
+    for (const auto vh : grid.mesh.fv_range(fh)) {
+      corners.push_back(vh.idx());
+    }
     for (size_t k = 1; k + 1 < corners.size(); ++k) {
       triangles.emplace_back(corners[0], corners[k], corners[k + 1]);
     }
@@ -137,12 +145,18 @@ MapMetrics measure_map(const ParticleGrid& grid, const Eigen::Matrix3Xd& target_
   if (!std::isfinite(sigma) || sigma <= 0.0) {
     throw InvalidInputError(name, "rest scale must be finite and positive");
   }
-  if (grid.mesh.n_faces() == 0) throw InvalidInputError(name, "the particle grid has no faces");
-  if (grid.springs.empty()) throw InvalidInputError(name, "the particle grid has no springs built");
+  if (grid.mesh.n_faces() == 0) {
+    throw InvalidInputError(name, "the particle grid has no faces");
+  }
+  if (grid.springs.empty()) {
+    throw InvalidInputError(name, "the particle grid has no springs built");
+  }
 
   const auto is_outside = [&](int p) { return !options.outside.empty() && options.outside[p]; };
   std::vector<char> skip(n, 0);
-  for (int p = 0; p < n; ++p) skip[p] = is_outside(p) ? 1 : 0;
+  for (int p = 0; p < n; ++p) {
+    skip[p] = is_outside(p) ? 1 : 0;
+  }
   // Outside particles may carry anything (NaN, zeros): only the placed ones must be finite.
   for (int p = 0; p < n; ++p) {
     if (!skip[p] && !target_positions.col(p).allFinite()) {
@@ -151,10 +165,14 @@ MapMetrics measure_map(const ParticleGrid& grid, const Eigen::Matrix3Xd& target_
     }
   }
   const Eigen::Matrix3Xd source = grid.source_positions();
-  if (!all_finite(source)) throw InvalidInputError(name, "a source position is not finite");
+  if (!all_finite(source)) {
+    throw InvalidInputError(name, "a source position is not finite");
+  }
 
   MapMetrics out;
-  for (int p = 0; p < n; ++p) out.outside += skip[p] ? 1 : 0;
+  for (int p = 0; p < n; ++p) {
+    out.outside += skip[p] ? 1 : 0;
+  }
 
   // Length energy (eq. 13, normalised by the energy of collapsing every spring to a point).
   {
@@ -163,7 +181,9 @@ MapMetrics measure_map(const ParticleGrid& grid, const Eigen::Matrix3Xd& target_
       if (s.i < 0 || s.i >= n || s.j < 0 || s.j >= n) {
         throw InvalidInputError(name, "a spring index is out of range");
       }
-      if (skip[s.i] || skip[s.j]) continue;
+      if (skip[s.i] || skip[s.j]) {
+        continue;
+      }
       const double rest = sigma * s.rest;
       const double len = (target_positions.col(s.j) - target_positions.col(s.i)).norm();
       num += (len - rest) * (len - rest);
@@ -312,8 +332,12 @@ MapMetrics measure_map(const ParticleGrid& grid, const Eigen::Matrix3Xd& target_
     out.conformal_distortion = w_conf / w_regular;
     out.symmetric_dirichlet = w_sd / w_regular;
   }
-  if (w_inv_sum > 0.0) out.inverse_stretch_l2 = std::sqrt(w_inv_stretch / w_inv_sum);
-  if (angle_count > 0) out.angle_error_mean_deg = angle_sum / static_cast<double>(angle_count);
+  if (w_inv_sum > 0.0) {
+    out.inverse_stretch_l2 = std::sqrt(w_inv_stretch / w_inv_sum);
+  }
+  if (angle_count > 0) {
+    out.angle_error_mean_deg = angle_sum / static_cast<double>(angle_count);
+  }
   out.folds = have_normals ? folds : -1;
   return out;
 }
@@ -324,7 +348,9 @@ Eigen::Matrix3Xd surface_normals(const LimitSurface& surface,
   const int n = static_cast<int>(points.size());
   Eigen::Matrix3Xd normals = Eigen::Matrix3Xd::Zero(3, n);
   for (int p = 0; p < n; ++p) {
-    if ((!skip.empty() && skip[p]) || !points[p].valid()) continue;
+    if ((!skip.empty() && skip[p]) || !points[p].valid()) {
+      continue;
+    }
     normals.col(p) = surface.curvature(points[p]).normal;
   }
   return normals;

@@ -15,9 +15,13 @@ namespace {
 // between them in the loop's order.
 double mid_parameter(double s_a, double s_b) {
   double gap = s_b - s_a;
-  if (gap <= 0.0) gap += 1.0;
+  if (gap <= 0.0) {
+    gap += 1.0;
+  }
   double s = s_a + 0.5 * gap;
-  if (s >= 1.0) s -= 1.0;
+  if (s >= 1.0) {
+    s -= 1.0;
+  }
   return s;
 }
 
@@ -29,7 +33,9 @@ GridSubdivisionResult subdivide_grid(const ParticleGrid& grid, const SurfaceProj
   const std::string& name = options.name;
   const GridMesh& mesh = grid.mesh;
   const int np = grid.num_particles();
-  if (np == 0 || mesh.n_faces() == 0) throw InvalidInputError(name, "grid has no particles");
+  if (np == 0 || mesh.n_faces() == 0) {
+    throw InvalidInputError(name, "grid has no particles");
+  }
   if (static_cast<int>(grid.source_points.size()) != np ||
       static_cast<int>(grid.is_boundary.size()) != np ||
       (!grid.source_uv.empty() && static_cast<int>(grid.source_uv.size()) != np)) {
@@ -46,7 +52,9 @@ GridSubdivisionResult subdivide_grid(const ParticleGrid& grid, const SurfaceProj
   if (use_plane && !options.plane_to_surface) {
     throw InvalidInputError(name, "plane coordinates given without plane_to_surface");
   }
-  if (source_curve.size() < 2) throw InvalidInputError(name, "source boundary curve is empty");
+  if (source_curve.size() < 2) {
+    throw InvalidInputError(name, "source boundary curve is empty");
+  }
 
   const int ne = static_cast<int>(mesh.n_edges());
   const int nf = static_cast<int>(mesh.n_faces());
@@ -66,14 +74,18 @@ GridSubdivisionResult subdivide_grid(const ParticleGrid& grid, const SurfaceProj
   std::vector<int> face_particle(static_cast<size_t>(nf), -1);
   int next = np + ne;
   for (const auto fh : mesh.faces()) {
-    if (mesh.valence(fh) == 4) face_particle[static_cast<size_t>(fh.idx())] = next++;
+    if (mesh.valence(fh) == 4) {
+      face_particle[static_cast<size_t>(fh.idx())] = next++;
+    }
   }
   const int n_new = next;
   result.edge_particles = ne;
   result.face_particles = n_new - np - ne;
 
   result.parents.resize(static_cast<size_t>(n_new));
-  for (int i = 0; i < np; ++i) result.parents[static_cast<size_t>(i)] = {{i, -1, -1, -1}, 1};
+  for (int i = 0; i < np; ++i) {
+    result.parents[static_cast<size_t>(i)] = {{i, -1, -1, -1}, 1};
+  }
   for (const auto eh : mesh.edges()) {
     const auto heh = mesh.halfedge_handle(eh, 0);
     result.parents[static_cast<size_t>(np + eh.idx())] = {
@@ -81,10 +93,13 @@ GridSubdivisionResult subdivide_grid(const ParticleGrid& grid, const SurfaceProj
   }
   for (const auto fh : mesh.faces()) {
     const int p = face_particle[static_cast<size_t>(fh.idx())];
-    if (p < 0) continue;
+    if (p < 0) {
+      continue;
+    }
     SubdivisionParents& parents = result.parents[static_cast<size_t>(p)];
-    for (const auto vh : mesh.fv_range(fh))
+    for (const auto vh : mesh.fv_range(fh)) {
       parents.parent[static_cast<size_t>(parents.count++)] = vh.idx();
+    }
   }
 
   // Boundary edges: the mesh's boundary must be exactly the boundary loop, edge k joining loop[k]
@@ -110,7 +125,9 @@ GridSubdivisionResult subdivide_grid(const ParticleGrid& grid, const SurfaceProj
     edge_on_boundary[static_cast<size_t>(e)] = 1;
   }
   int mesh_boundary_edges = 0;
-  for (const auto eh : mesh.edges()) mesh_boundary_edges += mesh.is_boundary(eh) ? 1 : 0;
+  for (const auto eh : mesh.edges()) {
+    mesh_boundary_edges += mesh.is_boundary(eh) ? 1 : 0;
+  }
   if (mesh_boundary_edges != static_cast<int>(m)) {
     throw InvalidInputError(name, "the grid's boundary has " + std::to_string(mesh_boundary_edges) +
                                       " edges but the boundary loop " + std::to_string(m) +
@@ -163,7 +180,9 @@ GridSubdivisionResult subdivide_grid(const ParticleGrid& grid, const SurfaceProj
   // Interior new particles: average in the plane, else the magnet of the average 3D position.
   std::vector<int> magnet;  // refined indices placed by the magnet
   for (int p = np; p < n_new; ++p) {
-    if (p < np + ne && edge_on_boundary[static_cast<size_t>(p - np)]) continue;
+    if (p < np + ne && edge_on_boundary[static_cast<size_t>(p - np)]) {
+      continue;
+    }
     const SubdivisionParents& parents = result.parents[static_cast<size_t>(p)];
     bool placed = false;
     if (use_plane) {
@@ -179,7 +198,9 @@ GridSubdivisionResult subdivide_grid(const ParticleGrid& grid, const SurfaceProj
         placed = true;
       }
     }
-    if (!placed) magnet.push_back(p);
+    if (!placed) {
+      magnet.push_back(p);
+    }
   }
   if (!magnet.empty()) {
     std::vector<Eigen::Vector3d> queries(magnet.size());
@@ -187,8 +208,9 @@ GridSubdivisionResult subdivide_grid(const ParticleGrid& grid, const SurfaceProj
     for (size_t k = 0; k < magnet.size(); ++k) {
       const SubdivisionParents& parents = result.parents[static_cast<size_t>(magnet[k])];
       Eigen::Vector3d x = Eigen::Vector3d::Zero();
-      for (int j = 0; j < parents.count; ++j)
+      for (int j = 0; j < parents.count; ++j) {
         x += coarse.col(parents.parent[static_cast<size_t>(j)]);
+      }
       queries[k] = x / parents.count;
       hints[k] = grid.source_points[static_cast<size_t>(parents.parent[0])];
     }
@@ -227,7 +249,9 @@ GridSubdivisionResult subdivide_grid(const ParticleGrid& grid, const SurfaceProj
   auto vh = [&](int i) { return refined.vertex_handle(static_cast<unsigned>(i)); };
   auto add = [&](std::initializer_list<int> corners, int parent_face) {
     std::vector<GridMesh::VertexHandle> handles;
-    for (int c : corners) handles.push_back(vh(c));
+    for (int c : corners) {
+      handles.push_back(vh(c));
+    }
     if (!refined.add_face(handles).is_valid()) {
       throw NumericalError(
           name, "cannot refine face " + std::to_string(parent_face) + " (non-manifold grid)");
@@ -244,11 +268,15 @@ GridSubdivisionResult subdivide_grid(const ParticleGrid& grid, const SurfaceProj
     const int f = fh.idx();
     if (corner.size() == 3) {
       // Corner triangles (c_k, e_k, e_{k-1}) and the middle one (e_0, e_1, e_2).
-      for (int k = 0; k < 3; ++k) add({corner[k], edge[k], edge[(k + 2) % 3]}, f);
+      for (int k = 0; k < 3; ++k) {
+        add({corner[k], edge[k], edge[(k + 2) % 3]}, f);
+      }
       add({edge[0], edge[1], edge[2]}, f);
     } else {
       const int centre = face_particle[static_cast<size_t>(f)];
-      for (int k = 0; k < 4; ++k) add({corner[k], edge[k], centre, edge[(k + 3) % 4]}, f);
+      for (int k = 0; k < 4; ++k) {
+        add({corner[k], edge[k], centre, edge[(k + 3) % 4]}, f);
+      }
     }
   }
   out.build_springs();

@@ -50,11 +50,15 @@ void ParticleGrid::build_springs() {
 PolygonMesh to_polygon_mesh(const ParticleGrid& grid, const Eigen::Matrix3Xd& positions) {
   PolygonMesh mesh;
   mesh.positions.reserve(static_cast<size_t>(positions.cols()));
-  for (Eigen::Index p = 0; p < positions.cols(); ++p) mesh.positions.emplace_back(positions.col(p));
+  for (Eigen::Index p = 0; p < positions.cols(); ++p) {
+    mesh.positions.emplace_back(positions.col(p));
+  }
   std::vector<int> corners;
   for (const auto f : grid.mesh.faces()) {
     corners.clear();
-    for (const auto v : grid.mesh.fv_range(f)) corners.push_back(v.idx());
+    for (const auto v : grid.mesh.fv_range(f)) {
+      corners.push_back(v.idx());
+    }
     mesh.add_face(corners);
   }
   if (!grid.source_uv.empty()) {

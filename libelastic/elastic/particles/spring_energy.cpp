@@ -26,13 +26,17 @@ bool finite_non_negative(double value) {
 void build_incidence(int num_particles, const std::vector<std::pair<int, int>>& pairs,
                      std::vector<int>& offset, std::vector<int>& entry) {
   offset.assign(static_cast<std::size_t>(num_particles) + 1, 0);
-  for (const auto& [particle, code] : pairs) ++offset[static_cast<std::size_t>(particle) + 1];
-  for (std::size_t p = 0; p < static_cast<std::size_t>(num_particles); ++p)
+  for (const auto& [particle, code] : pairs) {
+    ++offset[static_cast<std::size_t>(particle) + 1];
+  }
+  for (std::size_t p = 0; p < static_cast<std::size_t>(num_particles); ++p) {
     offset[p + 1] += offset[p];
+  }
   entry.resize(pairs.size());
   std::vector<int> fill(offset.begin(), offset.end() - 1);
-  for (const auto& [particle, code] : pairs)
+  for (const auto& [particle, code] : pairs) {
     entry[static_cast<std::size_t>(fill[particle]++)] = code;
+  }
 }
 
 }  // namespace
@@ -50,17 +54,24 @@ std::string_view to_string(RestScale mode) {
 }
 
 RestScale parse_rest_scale(std::string_view text, std::string_view input) {
-  if (text == "boundary") return RestScale::Boundary;
-  if (text == "area") return RestScale::Area;
-  if (text == "none") return RestScale::None;
+  if (text == "boundary") {
+    return RestScale::Boundary;
+  }
+  if (text == "area") {
+    return RestScale::Area;
+  }
+  if (text == "none") {
+    return RestScale::None;
+  }
   throw InvalidInputError(std::string(input), "unknown rest scale '" + std::string(text) +
                                                   "' (expected boundary, area or none)");
 }
 
 double rest_scale_factor(RestScale mode, const RegionSizes& sizes) {
   const auto check = [](double value, const char* what) {
-    if (!std::isfinite(value) || value <= 0.0)
+    if (!std::isfinite(value) || value <= 0.0) {
       throw InvalidInputError("rest scale", std::string(what) + " is not finite and positive");
+    }
   };
   switch (mode) {
     case RestScale::Boundary:
@@ -81,12 +92,15 @@ double rest_scale_factor(RestScale mode, const RegionSizes& sizes) {
 SpringSystem::SpringSystem(const ParticleGrid& grid, const SpringEnergyOptions& options)
     : grid_(&grid), options_(options), num_particles_(static_cast<int>(grid.mesh.n_vertices())) {
   const std::string name = "particle grid";
-  if (!finite_non_negative(options.stiffness) || !finite_non_negative(options.angular_stiffness))
+  if (!finite_non_negative(options.stiffness) || !finite_non_negative(options.angular_stiffness)) {
     throw InvalidInputError(name, "spring stiffness must be finite and non-negative");
-  if (!std::isfinite(options.rest_scale) || options.rest_scale <= 0.0)
+  }
+  if (!std::isfinite(options.rest_scale) || options.rest_scale <= 0.0) {
     throw InvalidInputError(name, "rest scale must be finite and positive");
-  if (grid.springs.empty() && num_particles_ > 1)
+  }
+  if (grid.springs.empty() && num_particles_ > 1) {
     throw InvalidInputError(name, "springs are not built (call build_springs())");
+  }
 
   const int n = num_particles_;
   const auto in_range = [n](int index) { return index >= 0 && index < n; };
@@ -95,11 +109,13 @@ SpringSystem::SpringSystem(const ParticleGrid& grid, const SpringEnergyOptions& 
   pairs.reserve(2 * grid.springs.size());
   for (std::size_t s = 0; s < grid.springs.size(); ++s) {
     const Spring& spring = grid.springs[s];
-    if (!in_range(spring.i) || !in_range(spring.j) || spring.i == spring.j)
+    if (!in_range(spring.i) || !in_range(spring.j) || spring.i == spring.j) {
       throw InvalidInputError(name,
                               "spring " + std::to_string(s) + " has invalid particle indices");
-    if (!finite_non_negative(spring.rest))
+    }
+    if (!finite_non_negative(spring.rest)) {
       throw InvalidInputError(name, "spring " + std::to_string(s) + " has an invalid rest length");
+    }
     const int code = 2 * static_cast<int>(s);
     pairs.emplace_back(spring.i, code + 1);
     pairs.emplace_back(spring.j, code);
@@ -111,12 +127,14 @@ SpringSystem::SpringSystem(const ParticleGrid& grid, const SpringEnergyOptions& 
   for (std::size_t c = 0; c < grid.angular_springs.size(); ++c) {
     const AngularSpring& spring = grid.angular_springs[c];
     if (!in_range(spring.i) || !in_range(spring.a) || !in_range(spring.b) || spring.a == spring.i ||
-        spring.b == spring.i || spring.a == spring.b)
+        spring.b == spring.i || spring.a == spring.b) {
       throw InvalidInputError(
           name, "angular spring " + std::to_string(c) + " has invalid particle indices");
-    if (!finite_non_negative(spring.rest))
+    }
+    if (!finite_non_negative(spring.rest)) {
       throw InvalidInputError(
           name, "angular spring " + std::to_string(c) + " has an invalid rest length");
+    }
     const int code = 2 * static_cast<int>(c);
     pairs.emplace_back(spring.i, code);
     pairs.emplace_back(spring.a, code + 1);
@@ -136,8 +154,9 @@ SpringSystem::SpringSystem(const ParticleGrid& grid, const SpringEnergyOptions& 
       heh = grid.mesh.next_halfedge_handle(heh);
     } while (heh != first);
     const std::size_t k = face.size();
-    for (std::size_t c = 0; c < k; ++c)
+    for (std::size_t c = 0; c < k; ++c) {
       corners_.push_back({face[c], face[(c + 1) % k], face[(c + k - 1) % k], fh.idx()});
+    }
   }
 
   spring_force_.resize(3, static_cast<Eigen::Index>(grid.springs.size()));
@@ -145,9 +164,10 @@ SpringSystem::SpringSystem(const ParticleGrid& grid, const SpringEnergyOptions& 
 }
 
 SpringEnergies SpringSystem::evaluate(const Eigen::Matrix3Xd& x, Eigen::Matrix3Xd* gradient) const {
-  if (x.cols() != num_particles_)
+  if (x.cols() != num_particles_) {
     throw InvalidInputError("particle positions", "expected " + std::to_string(num_particles_) +
                                                       " columns, got " + std::to_string(x.cols()));
+  }
   const std::vector<Spring>& springs = grid_->springs;
   const std::vector<AngularSpring>& angular = grid_->angular_springs;
   const double C = options_.stiffness;
@@ -169,10 +189,11 @@ SpringEnergies SpringSystem::evaluate(const Eigen::Matrix3Xd& x, Eigen::Matrix3X
           sum += C * stretch * stretch;
           if (want_gradient) {
             const auto col = static_cast<Eigen::Index>(s);
-            if (length > 0.0)
+            if (length > 0.0) {
               spring_force_.col(col) = (2.0 * C * stretch / length) * d;
-            else
+            } else {
               spring_force_.col(col).setZero();  // cone point: no gradient (see header)
+            }
           }
         }
         return sum;
@@ -192,10 +213,11 @@ SpringEnergies SpringSystem::evaluate(const Eigen::Matrix3Xd& x, Eigen::Matrix3X
           sum += Ca * stretch * stretch;
           if (want_gradient) {
             const auto col = static_cast<Eigen::Index>(c);
-            if (length > 0.0)
+            if (length > 0.0) {
               angular_force_.col(col) = (2.0 * Ca * stretch / length) * e;
-            else
+            } else {
               angular_force_.col(col).setZero();
+            }
           }
         }
         return sum;
@@ -211,17 +233,19 @@ SpringEnergies SpringSystem::evaluate(const Eigen::Matrix3Xd& x, Eigen::Matrix3X
                           Eigen::Vector3d g = Eigen::Vector3d::Zero();
                           for (int k = spring_offset_[p]; k < spring_offset_[p + 1]; ++k) {
                             const int code = spring_entry_[k];
-                            if (code & 1)
+                            if (code & 1) {
                               g -= spring_force_.col(code >> 1);
-                            else
+                            } else {
                               g += spring_force_.col(code >> 1);
+                            }
                           }
                           for (int k = angular_offset_[p]; k < angular_offset_[p + 1]; ++k) {
                             const int code = angular_entry_[k];
-                            if (code & 1)
+                            if (code & 1) {
                               g -= 0.5 * angular_force_.col(code >> 1);
-                            else
+                            } else {
                               g += angular_force_.col(code >> 1);
+                            }
                           }
                           gradient->col(p) = g;
                         }
@@ -270,14 +294,19 @@ SpringEnergies spring_energy(const ParticleGrid& grid, const Eigen::Matrix3Xd& x
 double magnet_energy(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& closest, double stiffness,
                      const std::vector<char>& active, Eigen::Matrix3Xd* gradient) {
   if (closest.cols() != x.cols() || (!active.empty() && active.size() != std::size_t(x.cols())) ||
-      (gradient != nullptr && gradient->cols() != x.cols()))
+      (gradient != nullptr && gradient->cols() != x.cols())) {
     throw InvalidInputError("magnet", "positions, closest points and gradient differ in size");
+  }
   double energy = 0.0;
   for (Eigen::Index p = 0; p < x.cols(); ++p) {
-    if (!active.empty() && !active[static_cast<std::size_t>(p)]) continue;
+    if (!active.empty() && !active[static_cast<std::size_t>(p)]) {
+      continue;
+    }
     const Eigen::Vector3d offset = x.col(p) - closest.col(p);
     energy += 0.5 * stiffness * offset.squaredNorm();
-    if (gradient != nullptr) gradient->col(p) += stiffness * offset;
+    if (gradient != nullptr) {
+      gradient->col(p) += stiffness * offset;
+    }
   }
   return energy;
 }

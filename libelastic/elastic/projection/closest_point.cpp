@@ -33,7 +33,9 @@ struct EmbreeDevice {
   RTCDevice device = nullptr;
   EmbreeDevice() : device(rtcNewDevice(nullptr)) {}
   ~EmbreeDevice() {
-    if (device) rtcReleaseDevice(device);
+    if (device) {
+      rtcReleaseDevice(device);
+    }
   }
   EmbreeDevice(const EmbreeDevice&) = delete;
   EmbreeDevice& operator=(const EmbreeDevice&) = delete;
@@ -77,17 +79,27 @@ TriangleHit closest_on_triangle(const Eigen::Vector3d& p, const Eigen::Vector3d&
     hit.dist2 = (a + w1 * ab + w2 * ac - p).squaredNorm();
     return hit;
   };
-  if (d1 <= 0.0 && d2 <= 0.0) return finish(0.0, 0.0);  // vertex a
+  if (d1 <= 0.0 && d2 <= 0.0) {
+    return finish(0.0, 0.0);  // vertex a
+  }
   const Eigen::Vector3d bp = p - b;
   const double d3 = ab.dot(bp), d4 = ac.dot(bp);
-  if (d3 >= 0.0 && d4 <= d3) return finish(1.0, 0.0);  // vertex b
+  if (d3 >= 0.0 && d4 <= d3) {
+    return finish(1.0, 0.0);  // vertex b
+  }
   const double vc = d1 * d4 - d3 * d2;
-  if (vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0) return finish(d1 / (d1 - d3), 0.0);  // edge ab
+  if (vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0) {
+    return finish(d1 / (d1 - d3), 0.0);  // edge ab
+  }
   const Eigen::Vector3d cp = p - c;
   const double d5 = ab.dot(cp), d6 = ac.dot(cp);
-  if (d6 >= 0.0 && d5 <= d6) return finish(0.0, 1.0);  // vertex c
+  if (d6 >= 0.0 && d5 <= d6) {
+    return finish(0.0, 1.0);  // vertex c
+  }
   const double vb = d5 * d2 - d1 * d6;
-  if (vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0) return finish(0.0, d2 / (d2 - d6));  // edge ac
+  if (vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0) {
+    return finish(0.0, d2 / (d2 - d6));  // edge ac
+  }
   const double va = d3 * d6 - d5 * d4;
   if (va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0) {  // edge bc
     const double t = (d4 - d3) / ((d4 - d3) + (d5 - d6));
@@ -96,7 +108,9 @@ TriangleHit closest_on_triangle(const Eigen::Vector3d& p, const Eigen::Vector3d&
   const double sum = va + vb + vc;
   if (!(sum > 0.0)) {  // degenerate (zero-area) triangle: fall back to the best vertex
     const double da = ap.squaredNorm(), db = bp.squaredNorm(), dc = cp.squaredNorm();
-    if (da <= db && da <= dc) return finish(0.0, 0.0);
+    if (da <= db && da <= dc) {
+      return finish(0.0, 0.0);
+    }
     return db <= dc ? finish(1.0, 0.0) : finish(0.0, 1.0);
   }
   return finish(vb / sum, vc / sum);  // face interior
@@ -180,7 +194,9 @@ struct SurfaceProjector::Impl {
   RTCScene scene = nullptr;
 
   ~Impl() {
-    if (scene) rtcReleaseScene(scene);
+    if (scene) {
+      rtcReleaseScene(scene);
+    }
   }
 
   const DomainEdge& edge(int k) const {
@@ -222,22 +238,27 @@ void SurfaceProjector::Impl::build_corner_nodes() {
   if (!triangular) {
     const PolygonMesh& mesh = surface->control_mesh();
     for (int f = 0; f < num_faces; ++f) {
-      if (mesh.face_size(surface->control_face(f)) != 4)
+      if (mesh.face_size(surface->control_face(f)) != 4) {
         face_resolution[static_cast<size_t>(f)] = std::max(1, t.resolution / 2);
+      }
     }
   }
 
   // Triangles grouped by face (counting sort), so each face's boundary nodes are evaluated once.
   std::vector<int> start(static_cast<size_t>(num_faces) + 1, 0);
-  for (int f : t.triangle_face) ++start[static_cast<size_t>(f) + 1];
-  for (int f = 0; f < num_faces; ++f)
+  for (int f : t.triangle_face) {
+    ++start[static_cast<size_t>(f) + 1];
+  }
+  for (int f = 0; f < num_faces; ++f) {
     start[static_cast<size_t>(f) + 1] += start[static_cast<size_t>(f)];
+  }
   std::vector<int> order(num_triangles);
   {
     std::vector<int> fill(start.begin(), start.end() - 1);
-    for (size_t i = 0; i < num_triangles; ++i)
+    for (size_t i = 0; i < num_triangles; ++i) {
       order[static_cast<size_t>(fill[static_cast<size_t>(t.triangle_face[i])]++)] =
           static_cast<int>(i);
+    }
   }
 
   tbb::parallel_for(tbb::blocked_range<int>(0, num_faces), [&](const tbb::blocked_range<int>& r) {
@@ -264,7 +285,9 @@ void SurfaceProjector::Impl::build_corner_nodes() {
                 for (int b = 0; b <= n; ++b) {
                   const bool on_edge = triangular ? (a == 0 || b == 0 || a + b == n)
                                                   : (a == 0 || b == 0 || a == n || b == n);
-                  if (!on_edge || (triangular && a + b > n)) continue;
+                  if (!on_edge || (triangular && a + b > n)) {
+                    continue;
+                  }
                   nodes.push_back({a, b});
                   node_positions.push_back(surface->position(
                       {f, static_cast<double>(a) / n, static_cast<double>(b) / n}));
@@ -300,8 +323,9 @@ void SurfaceProjector::Impl::build_boundary_edges() {
     std::uint8_t mask = 0;
     for (int k = 0; k < num_edges; ++k) {
       const Eigen::Vector2d m = edge(k).midpoint;
-      if (surface->on_boundary({f, m.x(), m.y()}))
+      if (surface->on_boundary({f, m.x(), m.y()})) {
         mask = static_cast<std::uint8_t>(mask | (1u << k));
+      }
     }
     boundary_edges[static_cast<size_t>(f)] = mask;
   }
@@ -330,7 +354,9 @@ void SurfaceProjector::Impl::estimate_tessellation_error() {
         }
       });
   double largest = 0.0;
-  for (double w : worst) largest = std::max(largest, w);
+  for (double w : worst) {
+    largest = std::max(largest, w);
+  }
   tessellation_error = 2.0 * largest;
 }
 
@@ -340,7 +366,9 @@ void SurfaceProjector::Impl::build_scene() {
   const LimitTessellation& t = tessellation;
   scene = rtcNewScene(device->device);
   RTCGeometry geometry = rtcNewGeometry(device->device, RTC_GEOMETRY_TYPE_TRIANGLE);
-  if (!scene || !geometry) throw Error(name, "cannot create the Embree scene");
+  if (!scene || !geometry) {
+    throw Error(name, "cannot create the Embree scene");
+  }
   // Float vertices are enough: the BVH only picks seed triangles, whose distances are recomputed in
   // double from the tessellation's own positions in the callback.
   auto* vertices = static_cast<float*>(rtcSetNewGeometryBuffer(geometry, RTC_BUFFER_TYPE_VERTEX, 0,
@@ -353,20 +381,25 @@ void SurfaceProjector::Impl::build_scene() {
     rtcReleaseGeometry(geometry);
     throw Error(name, "cannot allocate the Embree buffers");
   }
-  for (size_t v = 0; v < t.positions.size(); ++v)
-    for (int c = 0; c < 3; ++c)
+  for (size_t v = 0; v < t.positions.size(); ++v) {
+    for (int c = 0; c < 3; ++c) {
       vertices[3 * v + static_cast<size_t>(c)] = static_cast<float>(t.positions[v][c]);
-  for (size_t k = 0; k < t.triangles.size(); ++k)
-    for (int c = 0; c < 3; ++c)
+    }
+  }
+  for (size_t k = 0; k < t.triangles.size(); ++k) {
+    for (int c = 0; c < 3; ++c) {
       indices[3 * k + static_cast<size_t>(c)] = static_cast<unsigned>(t.triangles[k][c]);
+    }
+  }
   rtcCommitGeometry(geometry);
   rtcAttachGeometry(scene, geometry);
   rtcReleaseGeometry(geometry);
   rtcCommitScene(scene);
   const RTCError error = rtcGetDeviceError(device->device);
-  if (error != RTC_ERROR_NONE)
+  if (error != RTC_ERROR_NONE) {
     throw Error(name, "Embree failed to build the BVH (error " +
                           std::to_string(static_cast<int>(error)) + ")");
+  }
 }
 
 SurfacePoint SurfaceProjector::Impl::seed(int triangle, double w1, double w2) const {
@@ -432,7 +465,9 @@ NewtonRun SurfaceProjector::Impl::newton(const Eigen::Vector3d& x, SurfacePoint 
   int hops = 0;  // chart hops at face corners (see below)
   auto at_corner = [&](const SurfacePoint& q) {
     int on = 0;
-    for (int k = 0; k < num_edges; ++k) on += edge(k).normal.dot(q.uv()) - edge(k).offset <= 1e-9;
+    for (int k = 0; k < num_edges; ++k) {
+      on += edge(k).normal.dot(q.uv()) - edge(k).offset <= 1e-9;
+    }
     return on >= 2;
   };
 
@@ -482,7 +517,9 @@ NewtonRun SurfaceProjector::Impl::newton(const Eigen::Vector3d& x, SurfacePoint 
     // would leave through a boundary edge although descent points inside.
     auto descent_step = [&]() {
       const double gg = g.squaredNorm();
-      if (!(gg > 0.0)) return Eigen::Vector2d(Eigen::Vector2d::Zero());
+      if (!(gg > 0.0)) {
+        return Eigen::Vector2d(Eigen::Vector2d::Zero());
+      }
       const double ghg = g.x() * g.x() * h00 + 2.0 * g.x() * g.y() * h01 + g.y() * g.y() * h11;
       const double gjg = g.x() * g.x() * g00 + 2.0 * g.x() * g.y() * g01 + g.y() * g.y() * g11;
       return Eigen::Vector2d(-gg / std::max(std::abs(ghg), 1e-6 * gjg + 1e-300) * g);
@@ -500,9 +537,13 @@ NewtonRun SurfaceProjector::Impl::newton(const Eigen::Vector3d& x, SurfacePoint 
     if (mask) {
       const Eigen::Vector2d uv = p.uv();
       for (int k = 0; k < num_edges && num_active < 2; ++k) {
-        if (!(mask & (1u << k))) continue;
+        if (!(mask & (1u << k))) {
+          continue;
+        }
         const DomainEdge& e = edge(k);
-        if (e.normal.dot(uv) - e.offset <= kActiveTolerance) active[num_active++] = k;
+        if (e.normal.dot(uv) - e.offset <= kActiveTolerance) {
+          active[num_active++] = k;
+        }
       }
     }
 
@@ -526,14 +567,18 @@ NewtonRun SurfaceProjector::Impl::newton(const Eigen::Vector3d& x, SurfacePoint 
         step = edge_step(e.tangent);
       } else {
         step = free_step();
-        if (step.dot(e.normal) < 0.0) step = descent_step();
+        if (step.dot(e.normal) < 0.0) {
+          step = descent_step();
+        }
       }
     } else {
       const DomainEdge& a = edge(active[0]);
       const DomainEdge& b = edge(active[1]);
       if (-g.dot(a.normal) > 0.0 && -g.dot(b.normal) > 0.0) {
         step = free_step();
-        if (step.dot(a.normal) < 0.0 || step.dot(b.normal) < 0.0) step = descent_step();
+        if (step.dot(a.normal) < 0.0 || step.dot(b.normal) < 0.0) {
+          step = descent_step();
+        }
       } else {
         // Rays from the corner along each boundary edge, pointing into the domain.
         const Eigen::Vector2d ray_a =
@@ -554,11 +599,15 @@ NewtonRun SurfaceProjector::Impl::newton(const Eigen::Vector3d& x, SurfacePoint 
     }
 
     const double length = step.norm();
-    if (length > options.max_step) step *= options.max_step / length;
+    if (length > options.max_step) {
+      step *= options.max_step / length;
+    }
     if (!(step.norm() >= tolerance)) {  // also catches a NaN step
       run.converged = step.allFinite();
       run.on_boundary = constrained;
-      if (run.converged) run.last_step = step;
+      if (run.converged) {
+        run.last_step = step;
+      }
       break;
     }
     // A pure Newton step this short ends within ~C |s|^2 (~1e-16 C) of the minimum, and d(p + s) is
@@ -604,7 +653,9 @@ NewtonRun SurfaceProjector::Impl::newton(const Eigen::Vector3d& x, SurfacePoint 
         break;
       }
       step *= 0.5;
-      if (step.norm() < tolerance) break;
+      if (step.norm() < tolerance) {
+        break;
+      }
     }
     if (!accepted && hops < kMaxHops && at_corner(p)) {
       // At a face corner a straight step in this face's chart may leave through the corner into a
@@ -631,7 +682,9 @@ NewtonRun SurfaceProjector::Impl::newton(const Eigen::Vector3d& x, SurfacePoint 
       run.on_boundary = constrained;
       break;
     }
-    if (trial == p) break;  // blocked (walk could not move): leave it unconverged
+    if (trial == p) {
+      break;  // blocked (walk could not move): leave it unconverged
+    }
     run.travel += step.norm();
     p = trial;
     d = trial_d;
@@ -646,8 +699,9 @@ NewtonRun SurfaceProjector::Impl::newton(const Eigen::Vector3d& x, SurfacePoint 
     // A converged interior point can still sit on a boundary edge when descent points along it.
     const std::uint8_t mask = boundary_edges[static_cast<size_t>(p.face)];
     for (int k = 0; k < num_edges && mask; ++k) {
-      if ((mask & (1u << k)) && edge(k).normal.dot(p.uv()) - edge(k).offset <= kActiveTolerance)
+      if ((mask & (1u << k)) && edge(k).normal.dot(p.uv()) - edge(k).offset <= kActiveTolerance) {
         run.on_boundary = true;
+      }
     }
   }
   return run;
@@ -689,7 +743,9 @@ ClosestPoint SurfaceProjector::Impl::finish(const Eigen::Vector3d& x, const Newt
     n = dq.du.cross(dq.dv);
   }
   const double length = n.norm();
-  if (length > 0.0) out.normal = n / length;
+  if (length > 0.0) {
+    out.normal = n / length;
+  }
   return out;
 }
 
@@ -715,7 +771,9 @@ ClosestPoint SurfaceProjector::Impl::global(const Eigen::Vector3d& x) const {
                                                 t.positions[static_cast<size_t>(tri[1])],
                                                 t.positions[static_cast<size_t>(tri[2])]);
     if (q.limit < 0.0) {
-      if (hit.dist2 >= q.best.dist2) return false;
+      if (hit.dist2 >= q.best.dist2) {
+        return false;
+      }
       q.best = hit;
       q.best_triangle = static_cast<int>(args->primID);
       // The BVH holds float vertices: keep a little slack so float rounding does not cull the
@@ -724,7 +782,9 @@ ClosestPoint SurfaceProjector::Impl::global(const Eigen::Vector3d& x) const {
       args->query->radius = std::min(args->query->radius, static_cast<float>(radius) * 1.0001f);
       return true;
     }
-    if (hit.dist2 > q.limit * q.limit) return false;
+    if (hit.dist2 > q.limit * q.limit) {
+      return false;
+    }
     const int capacity = static_cast<int>(q.candidates.size());
     if (q.num_candidates < capacity) {
       q.candidates[static_cast<size_t>(q.num_candidates++)] = {hit, static_cast<int>(args->primID)};
@@ -732,7 +792,9 @@ ClosestPoint SurfaceProjector::Impl::global(const Eigen::Vector3d& x) const {
       auto worst = std::max_element(
           q.candidates.begin(), q.candidates.end(),
           [](const auto& a, const auto& b) { return a.first.dist2 < b.first.dist2; });
-      if (hit.dist2 < worst->first.dist2) *worst = {hit, static_cast<int>(args->primID)};
+      if (hit.dist2 < worst->first.dist2) {
+        *worst = {hit, static_cast<int>(args->primID)};
+      }
     }
     return false;
   };
@@ -777,10 +839,14 @@ ClosestPoint SurfaceProjector::Impl::global(const Eigen::Vector3d& x) const {
     int runs = 1;
     for (int c = 0; c < query.num_candidates && runs < options.max_global_seeds; ++c) {
       const auto& [hit, triangle] = query.candidates[static_cast<size_t>(c)];
-      if (triangle == query.best_triangle) continue;
+      if (triangle == query.best_triangle) {
+        continue;
+      }
       // A triangle cannot hide a limit point nearer than its own distance minus eps.
       const double lower = std::sqrt(hit.dist2) - tessellation_error;
-      if (lower * std::abs(lower) >= best.dist2) continue;
+      if (lower * std::abs(lower) >= best.dist2) {
+        continue;
+      }
       // Skip candidates within one triangle size of a Newton answer: they lie in its basin.
       const Eigen::Vector3i& tri = tessellation.triangles[static_cast<size_t>(triangle)];
       const Eigen::Vector3d& a = tessellation.positions[static_cast<size_t>(tri[0])];
@@ -790,15 +856,21 @@ ClosestPoint SurfaceProjector::Impl::global(const Eigen::Vector3d& x) const {
       const double size2 =
           std::max({(b - a).squaredNorm(), (cc - b).squaredNorm(), (a - cc).squaredNorm()});
       bool near_tried = false;
-      for (int k = 0; k < num_tried; ++k)
+      for (int k = 0; k < num_tried; ++k) {
         near_tried |= (tried[static_cast<size_t>(k)] - foot).squaredNorm() <= size2;
-      if (near_tried) continue;
+      }
+      if (near_tried) {
+        continue;
+      }
       NewtonRun run = newton(x, seed(triangle, hit.w1, hit.w2));
       ++runs;
-      if (num_tried < static_cast<int>(tried.size()))
+      if (num_tried < static_cast<int>(tried.size())) {
         tried[static_cast<size_t>(num_tried++)] = run.d.position;
+      }
       const bool better = run.converged == best.converged ? run.dist2 < best.dist2 : run.converged;
-      if (better) best = run;
+      if (better) {
+        best = run;
+      }
     }
   }
   return finish(x, best);
@@ -806,7 +878,9 @@ ClosestPoint SurfaceProjector::Impl::global(const Eigen::Vector3d& x) const {
 
 ClosestPoint SurfaceProjector::Impl::warm(const Eigen::Vector3d& x,
                                           const SurfacePoint& hint) const {
-  if (!hint.valid()) return global(x);
+  if (!hint.valid()) {
+    return global(x);
+  }
   if (hint.face >= surface->num_faces() || !surface->in_domain(hint, 1e-9)) {
     throw InvalidInputError(surface->name(), "warm-start hint (face " + std::to_string(hint.face) +
                                                  ", u " + std::to_string(hint.u) + ", v " +
@@ -822,7 +896,9 @@ ClosestPoint SurfaceProjector::Impl::warm(const Eigen::Vector3d& x,
     start.v /= sum;
   }
   const NewtonRun run = newton(x, start);
-  if (!run.converged || run.travel > options.warm_start_max_travel) return global(x);
+  if (!run.converged || run.travel > options.warm_start_max_travel) {
+    return global(x);
+  }
   return finish(x, run);
 }
 
@@ -831,15 +907,21 @@ ClosestPoint SurfaceProjector::Impl::warm(const Eigen::Vector3d& x,
 SurfaceProjector::SurfaceProjector(const LimitSurface& surface, const ProjectionOptions& options)
     : impl_(std::make_unique<Impl>()) {
   const std::string& name = surface.name();
-  if (options.max_newton_iterations < 1)
+  if (options.max_newton_iterations < 1) {
     throw InvalidInputError(name, "max_newton_iterations must be at least 1");
-  if (!(options.parameter_tolerance > 0.0) || !std::isfinite(options.parameter_tolerance))
+  }
+  if (!(options.parameter_tolerance > 0.0) || !std::isfinite(options.parameter_tolerance)) {
     throw InvalidInputError(name, "parameter_tolerance must be positive and finite");
-  if (!(options.max_step > 0.0)) throw InvalidInputError(name, "max_step must be positive");
-  if (!(options.warm_start_max_travel >= 0.0))
+  }
+  if (!(options.max_step > 0.0)) {
+    throw InvalidInputError(name, "max_step must be positive");
+  }
+  if (!(options.warm_start_max_travel >= 0.0)) {
     throw InvalidInputError(name, "warm_start_max_travel must not be negative");
-  if (options.max_global_seeds < 1)
+  }
+  if (options.max_global_seeds < 1) {
     throw InvalidInputError(name, "max_global_seeds must be at least 1");
+  }
 
   Impl& impl = *impl_;
   impl.surface = &surface;
@@ -847,10 +929,12 @@ SurfaceProjector::SurfaceProjector(const LimitSurface& surface, const Projection
   impl.triangular = surface.triangular_domain();
   impl.num_edges = impl.triangular ? 3 : 4;
   impl.tessellation = tessellate(surface, options.tessellation);
-  if (impl.tessellation.triangles.empty())
+  if (impl.tessellation.triangles.empty()) {
     throw InvalidInputError(name, "the surface has no triangles to project on");
-  if (impl.tessellation.resolution > 65535)
+  }
+  if (impl.tessellation.resolution > 65535) {
     throw InvalidInputError(name, "tessellation resolution too large for the projector");
+  }
   {
     Eigen::Vector3d lo = Eigen::Vector3d::Constant(kInf), hi = -lo;
     for (const Eigen::Vector3d& p : impl.tessellation.positions) {
@@ -889,19 +973,24 @@ ClosestPoint SurfaceProjector::closest(const Eigen::Vector3d& x, const SurfacePo
 void SurfaceProjector::closest(std::span<const Eigen::Vector3d> xs, std::span<ClosestPoint> out,
                                std::span<const SurfacePoint> hints) const {
   const std::string& name = impl_->surface->name();
-  if (out.size() != xs.size())
+  if (out.size() != xs.size()) {
     throw InvalidInputError(name, "batched closest-point query: " + std::to_string(xs.size()) +
                                       " points but " + std::to_string(out.size()) + " outputs");
-  if (!hints.empty() && hints.size() != xs.size())
+  }
+  if (!hints.empty() && hints.size() != xs.size()) {
     throw InvalidInputError(name, "batched closest-point query: " + std::to_string(xs.size()) +
                                       " points but " + std::to_string(hints.size()) + " hints");
+  }
   // Validate up front so that a bad input throws before any work and on the calling thread.
-  for (const Eigen::Vector3d& x : xs) impl_->check_query(x);
+  for (const Eigen::Vector3d& x : xs) {
+    impl_->check_query(x);
+  }
   const Impl& impl = *impl_;
   tbb::parallel_for(tbb::blocked_range<size_t>(0, xs.size(), 64),
                     [&](const tbb::blocked_range<size_t>& r) {
-                      for (size_t i = r.begin(); i < r.end(); ++i)
+                      for (size_t i = r.begin(); i < r.end(); ++i) {
                         out[i] = hints.empty() ? impl.global(xs[i]) : impl.warm(xs[i], hints[i]);
+                      }
                     });
 }
 

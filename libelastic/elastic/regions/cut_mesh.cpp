@@ -23,7 +23,9 @@ double cross2(const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
 Eigen::Vector3d barycentric_2d(const std::array<Eigen::Vector2d, 3>& tri,
                                const Eigen::Vector2d& p) {
   const double area = cross2(tri[1] - tri[0], tri[2] - tri[0]);
-  if (area == 0.0) return Eigen::Vector3d::Zero();
+  if (area == 0.0) {
+    return Eigen::Vector3d::Zero();
+  }
   const double b1 = cross2(p - tri[0], tri[2] - tri[0]) / area;
   const double b2 = cross2(tri[1] - tri[0], p - tri[0]) / area;
   return {1.0 - b1 - b2, b1, b2};
@@ -40,7 +42,9 @@ std::vector<std::array<Eigen::Vector2d, 3>> tessellation_corner_uv(const LimitSu
   auto boundary_nodes =
       [&](int f) -> const std::vector<std::pair<Eigen::Vector2d, Eigen::Vector3d>>& {
     auto it = nodes.find(f);
-    if (it != nodes.end()) return it->second;
+    if (it != nodes.end()) {
+      return it->second;
+    }
     auto& list = nodes[f];
     const int cf = surface.control_face(f);
     const int m = (!loop && control.face_size(cf) != 4) ? tess.resolution / 2 : tess.resolution;
@@ -48,7 +52,9 @@ std::vector<std::array<Eigen::Vector2d, 3>> tessellation_corner_uv(const LimitSu
       for (int i = 0; i <= m; ++i) {
         const bool on_edge = loop ? (i + j <= m && (i == 0 || j == 0 || i + j == m))
                                   : (i == 0 || j == 0 || i == m || j == m);
-        if (!on_edge) continue;
+        if (!on_edge) {
+          continue;
+        }
         const SurfacePoint p{f, static_cast<double>(i) / m, static_cast<double>(j) / m};
         list.emplace_back(p.uv(), surface.position(p));
       }
@@ -98,7 +104,9 @@ CutMesh::CutMesh(const LimitSurface& surface, const LimitTessellation& tess,
   vertex_triangles.resize(positions.size());
   for (int t = 0; t < nt; ++t) {
     children[static_cast<size_t>(t)].push_back(t);
-    for (int k = 0; k < 3; ++k) vertex_triangles[static_cast<size_t>(triangles[t][k])].push_back(t);
+    for (int k = 0; k < 3; ++k) {
+      vertex_triangles[static_cast<size_t>(triangles[t][k])].push_back(t);
+    }
   }
   on_curve.assign(positions.size(), 0);
 }
@@ -114,7 +122,9 @@ void CutMesh::enable_texture_chart() {
 
 int CutMesh::corner(int t, int v) const {
   for (int k = 0; k < 3; ++k) {
-    if (triangles[static_cast<size_t>(t)][k] == v) return k;
+    if (triangles[static_cast<size_t>(t)][k] == v) {
+      return k;
+    }
   }
   return -1;
 }
@@ -133,7 +143,9 @@ int CutMesh::add_triangle(const Eigen::Vector3i& tri, int parent) {
   triangles.push_back(tri);
   face.push_back(face[static_cast<size_t>(parent)]);
   uv.push_back(uv[static_cast<size_t>(parent)]);
-  if (!tex.empty()) tex.push_back(tex[static_cast<size_t>(parent)]);
+  if (!tex.empty()) {
+    tex.push_back(tex[static_cast<size_t>(parent)]);
+  }
   origin.push_back(origin[static_cast<size_t>(parent)]);
   children[static_cast<size_t>(origin.back())].push_back(id);
   return id;
@@ -142,7 +154,9 @@ int CutMesh::add_triangle(const Eigen::Vector3i& tri, int parent) {
 std::vector<int> CutMesh::edge_triangles(int a, int b) const {
   std::vector<int> out;
   for (int t : vertex_triangles[static_cast<size_t>(a)]) {
-    if (corner(t, b) >= 0) out.push_back(t);
+    if (corner(t, b) >= 0) {
+      out.push_back(t);
+    }
   }
   return out;
 }
@@ -159,7 +173,9 @@ int CutMesh::split_edge(int a, int b, double t) {
     const double s = forward ? t : 1.0 - t;
     const Eigen::Vector2d uv_n =
         (1.0 - s) * uv[ti][static_cast<size_t>(kx)] + s * uv[ti][static_cast<size_t>(ky)];
-    if (n < 0) n = add_vertex(SurfacePoint{face[ti], uv_n.x(), uv_n.y()});
+    if (n < 0) {
+      n = add_vertex(SurfacePoint{face[ti], uv_n.x(), uv_n.y()});
+    }
     const int x = triangles[ti][kx], y = triangles[ti][ky], z = triangles[ti][kz];
     // (x, y, z) -> (x, n, z) + (n, y, z), both keep the winding.
     const int t2 = add_triangle(Eigen::Vector3i(n, y, z), tri);
@@ -179,7 +195,9 @@ int CutMesh::split_edge(int a, int b, double t) {
     vertex_triangles[static_cast<size_t>(n)].push_back(tri);
     vertex_triangles[static_cast<size_t>(n)].push_back(t2);
   }
-  if (n < 0) throw NumericalError(name_, "internal: split of a missing edge");
+  if (n < 0) {
+    throw NumericalError(name_, "internal: split of a missing edge");
+  }
   return n;
 }
 
@@ -214,7 +232,9 @@ int CutMesh::split_triangle(int tri, const Eigen::Vector3d& bary) {
 int CutMesh::insert_in_triangle(int tri, Eigen::Vector3d bary, double snap) {
   // Coordinates within round-off of zero are zero (the point is on that edge or vertex).
   constexpr double zero = 1e-9;
-  for (int k = 0; k < 3; ++k) bary[k] = bary[k] < zero ? 0.0 : bary[k];
+  for (int k = 0; k < 3; ++k) {
+    bary[k] = bary[k] < zero ? 0.0 : bary[k];
+  }
   bary /= bary.sum();
   const Eigen::Vector3i v = triangles[static_cast<size_t>(tri)];
   int kmax = 0;
@@ -235,7 +255,9 @@ int CutMesh::insert_in_triangle(int tri, Eigen::Vector3d bary, double snap) {
     if (bary[k] == 0.0) {
       const int a = v[(k + 1) % 3], b = v[(k + 2) % 3];
       const double t = bary[(k + 2) % 3] / (bary[(k + 1) % 3] + bary[(k + 2) % 3]);
-      if (is_curve_edge(a, b)) throw_crossing();
+      if (is_curve_edge(a, b)) {
+        throw_crossing();
+      }
       return split_edge(a, b, t);
     }
   }
@@ -248,15 +270,18 @@ int CutMesh::insert_point(int origin_triangle, const Eigen::Vector2d& p, double 
   Eigen::Vector3d best_bary = Eigen::Vector3d::Zero();
   for (int t : children[static_cast<size_t>(origin_triangle)]) {
     const Eigen::Vector3d b = barycentric_2d(uv[static_cast<size_t>(t)], p);
-    if (b.isZero()) continue;
+    if (b.isZero()) {
+      continue;
+    }
     if (b.minCoeff() > best_min) {
       best_min = b.minCoeff();
       best = t;
       best_bary = b;
     }
   }
-  if (best < 0)
+  if (best < 0) {
     throw NumericalError(name_, "internal: cannot locate a curve point in its triangle");
+  }
   best_bary = best_bary.cwiseMax(0.0);
   return insert_in_triangle(best, best_bary / best_bary.sum(), snap);
 }
@@ -280,7 +305,9 @@ void CutMesh::walk(int a, Eigen::Vector2d ca, int b, Chart chart, int walk_face,
   auto find_cb = [&]() {
     double best = std::numeric_limits<double>::infinity();
     for (int t : vertex_triangles[static_cast<size_t>(b)]) {
-      if (walk_face >= 0 && face[static_cast<size_t>(t)] != walk_face) continue;
+      if (walk_face >= 0 && face[static_cast<size_t>(t)] != walk_face) {
+        continue;
+      }
       const Eigen::Vector2d c = chart_coordinate(chart, t, b);
       // Among several coordinates (a texture seam through b) take the nearest to a's.
       const double d = (c - ca).squaredNorm();
@@ -291,30 +318,41 @@ void CutMesh::walk(int a, Eigen::Vector2d ca, int b, Chart chart, int walk_face,
     }
   };
   find_cb();
-  if (!std::isfinite(cb.x()))
+  if (!std::isfinite(cb.x())) {
     throw NumericalError(name_, "internal: curve point not in the walked face");
+  }
   const int limit = 4 * num_triangles() + 16;
   for (int step = 0; step < limit; ++step) {
-    if (a == b) return;
+    if (a == b) {
+      return;
+    }
     if (!edge_triangles(a, b).empty()) {
       add_curve_edge(a, b);
       return;
     }
     const Eigen::Vector2d d = cb - ca;
-    if (d.norm() == 0.0) throw NumericalError(name_, "internal: coincident curve points");
+    if (d.norm() == 0.0) {
+      throw NumericalError(name_, "internal: coincident curve points");
+    }
     const Eigen::Vector2d dn = d.normalized();
     // The triangle at a whose angular sector (in the chart) contains the direction to b.
     int best = -1;
     double best_score = -std::numeric_limits<double>::infinity();
     for (int t : vertex_triangles[static_cast<size_t>(a)]) {
-      if (walk_face >= 0 && face[static_cast<size_t>(t)] != walk_face) continue;
-      if ((chart_coordinate(chart, t, a) - ca).norm() > chart_tol) continue;
+      if (walk_face >= 0 && face[static_cast<size_t>(t)] != walk_face) {
+        continue;
+      }
+      if ((chart_coordinate(chart, t, a) - ca).norm() > chart_tol) {
+        continue;
+      }
       const int k = corner(t, a);
       const int p = triangles[static_cast<size_t>(t)][(k + 1) % 3];
       const int q = triangles[static_cast<size_t>(t)][(k + 2) % 3];
       const Eigen::Vector2d ep = (chart_coordinate(chart, t, p) - ca).normalized();
       const Eigen::Vector2d eq = (chart_coordinate(chart, t, q) - ca).normalized();
-      if (cross2(ep, eq) <= 0.0) continue;  // degenerate in the chart
+      if (cross2(ep, eq) <= 0.0) {
+        continue;  // degenerate in the chart
+      }
       const double score = std::min(cross2(ep, dn), cross2(dn, eq));
       if (score > best_score) {
         best_score = score;
@@ -345,11 +383,15 @@ void CutMesh::walk(int a, Eigen::Vector2d ca, int b, Chart chart, int walk_face,
       next = q;
       cnext = cq;
     } else {
-      if (is_curve_edge(p, q)) throw_crossing();
+      if (is_curve_edge(p, q)) {
+        throw_crossing();
+      }
       cnext = (1.0 - r) * cp + r * cq;
       next = split_edge(p, q, r);
     }
-    if (next != b && on_curve[static_cast<size_t>(next)]) throw_crossing();
+    if (next != b && on_curve[static_cast<size_t>(next)]) {
+      throw_crossing();
+    }
     on_curve[static_cast<size_t>(next)] = 1;
     add_curve_edge(a, next);
     a = next;
@@ -364,8 +406,12 @@ std::vector<std::vector<int>> CutMesh::components(const std::vector<char>* keep)
   std::vector<std::vector<int>> out;
   std::vector<int> stack;
   for (int seed = 0; seed < nt; ++seed) {
-    if (label[static_cast<size_t>(seed)] >= 0) continue;
-    if (keep && !(*keep)[static_cast<size_t>(seed)]) continue;
+    if (label[static_cast<size_t>(seed)] >= 0) {
+      continue;
+    }
+    if (keep && !(*keep)[static_cast<size_t>(seed)]) {
+      continue;
+    }
     const int id = static_cast<int>(out.size());
     out.emplace_back();
     stack.assign(1, seed);
@@ -377,10 +423,16 @@ std::vector<std::vector<int>> CutMesh::components(const std::vector<char>* keep)
       for (int k = 0; k < 3; ++k) {
         const int a = triangles[static_cast<size_t>(t)][k],
                   b = triangles[static_cast<size_t>(t)][(k + 1) % 3];
-        if (is_curve_edge(a, b)) continue;
+        if (is_curve_edge(a, b)) {
+          continue;
+        }
         for (int n : edge_triangles(a, b)) {
-          if (label[static_cast<size_t>(n)] >= 0) continue;
-          if (keep && !(*keep)[static_cast<size_t>(n)]) continue;
+          if (label[static_cast<size_t>(n)] >= 0) {
+            continue;
+          }
+          if (keep && !(*keep)[static_cast<size_t>(n)]) {
+            continue;
+          }
           label[static_cast<size_t>(n)] = id;
           stack.push_back(n);
         }
@@ -421,14 +473,18 @@ PatchTopology patch_topology(const CutMesh& mesh, const std::vector<int>& tris) 
       static_cast<int>(static_cast<long>(verts.size()) - edges + static_cast<long>(tris.size()));
   std::set<int> visited;
   for (const auto& [start, unused] : next) {
-    if (visited.count(start)) continue;
+    if (visited.count(start)) {
+      continue;
+    }
     std::vector<int> loop;
     int v = start;
     while (!visited.count(v)) {
       visited.insert(v);
       loop.push_back(v);
       auto it = next.find(v);
-      if (it == next.end()) break;
+      if (it == next.end()) {
+        break;
+      }
       v = it->second;
     }
     topo.loops.push_back(std::move(loop));
@@ -458,7 +514,9 @@ Region make_region_from_patch(const CutMesh& mesh, const std::vector<int>& tris,
     region.triangle_face.push_back(mesh.face[static_cast<size_t>(t)]);
     region.triangle_uv.push_back(mesh.uv[static_cast<size_t>(t)]);
   }
-  for (int v : topology.loops.front()) region.boundary.push_back(index[static_cast<size_t>(v)]);
+  for (int v : topology.loops.front()) {
+    region.boundary.push_back(index[static_cast<size_t>(v)]);
+  }
   if (mesh.surface().control_mesh().has_texcoords()) {
     region.texcoords.reserve(region.points.size());
     for (const SurfacePoint& p : region.points) {

@@ -17,7 +17,9 @@ using Triplets = std::vector<Eigen::Triplet<double>>;
 std::vector<int> support(const MeshLocation& p, const std::vector<Eigen::Vector3i>& tri) {
   std::vector<int> out;
   for (int k = 0; k < 3; ++k) {
-    if (p.bary[k] > 0.0) out.push_back(tri[static_cast<size_t>(p.triangle)][k]);
+    if (p.bary[k] > 0.0) {
+      out.push_back(tri[static_cast<size_t>(p.triangle)][k]);
+    }
   }
   return out;
 }
@@ -42,7 +44,9 @@ HeatGeodesics::HeatGeodesics(const std::vector<Eigen::Vector3d>& positions,
       const int i = v[k], j = v[(k + 1) % 3], l = v[(k + 2) % 3];
       total_edge += (x_[static_cast<size_t>(j)] - x_[static_cast<size_t>(i)]).norm();
       mass.emplace_back(i, i, double_area / 6.0);
-      if (double_area == 0.0) continue;
+      if (double_area == 0.0) {
+        continue;
+      }
       // cot of the angle at i weighs the opposite edge (j, l): cot = (a.b) / |a x b|.
       const double cot = (x_[static_cast<size_t>(j)] - x_[static_cast<size_t>(i)])
                              .dot(x_[static_cast<size_t>(l)] - x_[static_cast<size_t>(i)]) /
@@ -69,7 +73,9 @@ HeatGeodesics::HeatGeodesics(const std::vector<Eigen::Vector3d>& positions,
 
 Eigen::VectorXd HeatGeodesics::heat(const MeshLocation& source) const {
   Eigen::VectorXd rhs = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(x_.size()));
-  for (int k = 0; k < 3; ++k) rhs[tri_[static_cast<size_t>(source.triangle)][k]] += source.bary[k];
+  for (int k = 0; k < 3; ++k) {
+    rhs[tri_[static_cast<size_t>(source.triangle)][k]] += source.bary[k];
+  }
   Eigen::VectorXd u = heat_solver_->solve(rhs);
   if (heat_solver_->info() != Eigen::Success || !u.allFinite()) {
     throw NumericalError(name_, "heat method: heat solve failed");
@@ -84,7 +90,9 @@ Eigen::Vector3d HeatGeodesics::gradient(int t, const Eigen::VectorXd& f) const {
   const Eigen::Vector3d& x2 = x_[static_cast<size_t>(v[2])];
   const Eigen::Vector3d normal = (x1 - x0).cross(x2 - x0);
   const double double_area = normal.norm();
-  if (double_area == 0.0) return Eigen::Vector3d::Zero();
+  if (double_area == 0.0) {
+    return Eigen::Vector3d::Zero();
+  }
   const Eigen::Vector3d n = normal / double_area;
   // grad f = sum_i f_i (n x e_i) / (2A), e_i the edge opposite corner i, counter-clockwise.
   return (f[v[0]] * n.cross(x2 - x1) + f[v[1]] * n.cross(x0 - x2) + f[v[2]] * n.cross(x1 - x0)) /
@@ -99,7 +107,9 @@ Eigen::VectorXd HeatGeodesics::distance(const MeshLocation& source) const {
   Eigen::VectorXd div = Eigen::VectorXd::Zero(nv);
   for (size_t t = 0; t < tri_.size(); ++t) {
     Eigen::Vector3d g = gradient(static_cast<int>(t), u);
-    if (g.norm() == 0.0) continue;
+    if (g.norm() == 0.0) {
+      continue;
+    }
     const Eigen::Vector3d field = -g.normalized();
     const Eigen::Vector3i& v = tri_[t];
     for (int k = 0; k < 3; ++k) {
@@ -107,7 +117,9 @@ Eigen::VectorXd HeatGeodesics::distance(const MeshLocation& source) const {
       const Eigen::Vector3d& xj = x_[static_cast<size_t>(v[(k + 1) % 3])];
       const Eigen::Vector3d& xl = x_[static_cast<size_t>(v[(k + 2) % 3])];
       const double cross = (xj - xi).cross(xl - xi).norm();
-      if (cross == 0.0) continue;
+      if (cross == 0.0) {
+        continue;
+      }
       const double cot_l = (xi - xl).dot(xj - xl) / cross;  // angle at l, opposite edge i-j
       const double cot_j = (xi - xj).dot(xl - xj) / cross;  // angle at j, opposite edge i-l
       div[v[k]] += 0.5 * (cot_l * (xj - xi).dot(field) + cot_j * (xl - xi).dot(field));
@@ -121,23 +133,31 @@ Eigen::VectorXd HeatGeodesics::distance(const MeshLocation& source) const {
   std::vector<int> index(static_cast<size_t>(nv), -1);
   int free = 0;
   for (int i = 0; i < nv; ++i) {
-    if (i != pin) index[static_cast<size_t>(i)] = free++;
+    if (i != pin) {
+      index[static_cast<size_t>(i)] = free++;
+    }
   }
   Triplets trip;
   for (int c = 0; c < laplacian_.outerSize(); ++c) {
     for (Eigen::SparseMatrix<double>::InnerIterator it(laplacian_, c); it; ++it) {
       const int r = index[static_cast<size_t>(it.row())], cc = index[static_cast<size_t>(it.col())];
-      if (r >= 0 && cc >= 0) trip.emplace_back(r, cc, it.value());
+      if (r >= 0 && cc >= 0) {
+        trip.emplace_back(r, cc, it.value());
+      }
     }
   }
   // A tiny shift keeps other connected components (not holding the pin) non-singular.
   const double shift = 1e-12;
-  for (int i = 0; i < free; ++i) trip.emplace_back(i, i, shift);
+  for (int i = 0; i < free; ++i) {
+    trip.emplace_back(i, i, shift);
+  }
   Eigen::SparseMatrix<double> a(free, free);
   a.setFromTriplets(trip.begin(), trip.end());
   Eigen::VectorXd rhs(free);
   for (int i = 0; i < nv; ++i) {
-    if (index[static_cast<size_t>(i)] >= 0) rhs[index[static_cast<size_t>(i)]] = -div[i];
+    if (index[static_cast<size_t>(i)] >= 0) {
+      rhs[index[static_cast<size_t>(i)]] = -div[i];
+    }
   }
   Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver(a);
   if (solver.info() != Eigen::Success) {
@@ -148,10 +168,13 @@ Eigen::VectorXd HeatGeodesics::distance(const MeshLocation& source) const {
     throw NumericalError(name_, "heat method: Poisson solve failed");
   }
   Eigen::VectorXd phi(nv);
-  for (int i = 0; i < nv; ++i) phi[i] = i == pin ? 0.0 : y[index[static_cast<size_t>(i)]];
+  for (int i = 0; i < nv; ++i) {
+    phi[i] = i == pin ? 0.0 : y[index[static_cast<size_t>(i)]];
+  }
   double at_source = 0.0;
-  for (int k = 0; k < 3; ++k)
+  for (int k = 0; k < 3; ++k) {
     at_source += source.bary[k] * phi[tri_[static_cast<size_t>(source.triangle)][k]];
+  }
   phi.array() -= at_source;
   // The heat step rounds off the distance cone's tip, which shifts phi by a roughly constant amount
   // everywhere away from the source (phi underestimates the distance). Near the source the geodesic
@@ -166,8 +189,9 @@ Eigen::VectorXd HeatGeodesics::distance(const MeshLocation& source) const {
   std::vector<double> offsets;
   for (int i = 0; i < nv; ++i) {
     const double chord = (x_[static_cast<size_t>(i)] - centre).norm();
-    if (chord >= 3.0 * h_ && chord <= 6.0 * h_ && phi[i] < 8.0 * h_)
+    if (chord >= 3.0 * h_ && chord <= 6.0 * h_ && phi[i] < 8.0 * h_) {
       offsets.push_back(phi[i] - chord);
+    }
   }
   if (offsets.size() >= 8) {
     std::nth_element(offsets.begin(),
@@ -180,13 +204,19 @@ Eigen::VectorXd HeatGeodesics::distance(const MeshLocation& source) const {
 
 std::vector<int> HeatGeodesics::triangles_at(const MeshLocation& p) const {
   const std::vector<int> s = support(p, tri_);
-  if (s.size() == 3) return {p.triangle};
+  if (s.size() == 3) {
+    return {p.triangle};
+  }
   std::vector<int> out;
   for (int t : vertex_triangles_[static_cast<size_t>(s[0])]) {
     const Eigen::Vector3i& v = tri_[static_cast<size_t>(t)];
     bool all = true;
-    for (int w : s) all = all && (v[0] == w || v[1] == w || v[2] == w);
-    if (all) out.push_back(t);
+    for (int w : s) {
+      all = all && (v[0] == w || v[1] == w || v[2] == w);
+    }
+    if (all) {
+      out.push_back(t);
+    }
   }
   return out;
 }
@@ -196,9 +226,13 @@ Eigen::Vector3d HeatGeodesics::bary_in(const MeshLocation& p, int t) const {
   const Eigen::Vector3i& from = tri_[static_cast<size_t>(p.triangle)];
   const Eigen::Vector3i& to = tri_[static_cast<size_t>(t)];
   for (int k = 0; k < 3; ++k) {
-    if (p.bary[k] <= 0.0) continue;
+    if (p.bary[k] <= 0.0) {
+      continue;
+    }
     for (int l = 0; l < 3; ++l) {
-      if (to[l] == from[k]) b[l] = p.bary[k];
+      if (to[l] == from[k]) {
+        b[l] = p.bary[k];
+      }
     }
   }
   return b;
@@ -215,7 +249,9 @@ std::vector<PathNode> HeatGeodesics::trace_path(const MeshLocation& from,
   };
   auto value = [&](const MeshLocation& p) {
     double s = 0.0;
-    for (int k = 0; k < 3; ++k) s += p.bary[k] * u[tri_[static_cast<size_t>(p.triangle)][k]];
+    for (int k = 0; k < 3; ++k) {
+      s += p.bary[k] * u[tri_[static_cast<size_t>(p.triangle)][k]];
+    }
     return s;
   };
   std::vector<PathNode> path;
@@ -235,7 +271,9 @@ std::vector<PathNode> HeatGeodesics::trace_path(const MeshLocation& from,
     Eigen::Vector3d best_bary;
     for (int t : cands) {
       const Eigen::Vector3d g = gradient(t, u);
-      if (g.norm() == 0.0) continue;
+      if (g.norm() == 0.0) {
+        continue;
+      }
       const Eigen::Vector3d b = bary_in(cur, t);
       const Eigen::Vector3i& v = tri_[static_cast<size_t>(t)];
       const Eigen::Vector3d& x0 = x_[static_cast<size_t>(v[0])];
@@ -243,7 +281,9 @@ std::vector<PathNode> HeatGeodesics::trace_path(const MeshLocation& from,
       const Eigen::Vector3d& x2 = x_[static_cast<size_t>(v[2])];
       const Eigen::Vector3d normal = (x1 - x0).cross(x2 - x0);
       const double double_area = normal.norm();
-      if (double_area == 0.0) continue;
+      if (double_area == 0.0) {
+        continue;
+      }
       const Eigen::Vector3d n = normal / double_area;
       // Rate of change of the barycentric coordinates along g (grad lambda_i = n x e_i / 2A).
       const Eigen::Vector3d db(g.dot(n.cross(x2 - x1)), g.dot(n.cross(x0 - x2)),
@@ -254,7 +294,9 @@ std::vector<PathNode> HeatGeodesics::trace_path(const MeshLocation& from,
       double s = std::numeric_limits<double>::infinity();
       int exit = -1;
       for (int k = 0; k < 3; ++k) {
-        if (rate[k] >= -tiny) continue;
+        if (rate[k] >= -tiny) {
+          continue;
+        }
         if (b[k] <= 0.0) {
           enters = false;  // the gradient points out of t through this corner's opposite edge
           break;
@@ -265,7 +307,9 @@ std::vector<PathNode> HeatGeodesics::trace_path(const MeshLocation& from,
           exit = k;
         }
       }
-      if (!enters || exit < 0) continue;
+      if (!enters || exit < 0) {
+        continue;
+      }
       const double progress = s * g.norm();
       if (progress > best_progress) {
         best_progress = progress;
@@ -274,7 +318,9 @@ std::vector<PathNode> HeatGeodesics::trace_path(const MeshLocation& from,
         nb[exit] = 0.0;
         // Snap coordinates within 1e-7 of zero so the path meets vertices instead of crawling near
         // them.
-        for (int k = 0; k < 3; ++k) nb[k] = nb[k] < 1e-7 ? 0.0 : nb[k];
+        for (int k = 0; k < 3; ++k) {
+          nb[k] = nb[k] < 1e-7 ? 0.0 : nb[k];
+        }
         best_bary = nb / nb.sum();
       }
     }

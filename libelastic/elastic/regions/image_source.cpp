@@ -21,7 +21,9 @@ ImagePlane make_image_plane(const std::filesystem::path& image, const ImagePlane
   if (!(options.ellipse_margin >= 0.0 && options.ellipse_margin < 0.5)) {
     throw InvalidInputError(name, "ellipse margin must be in [0, 0.5)");
   }
-  if (!std::ifstream(image, std::ios::binary)) throw IoError(name, "cannot open the image");
+  if (!std::ifstream(image, std::ios::binary)) {
+    throw IoError(name, "cannot open the image");
+  }
   int columns = 0, rows = 0, channels = 0;
   if (!stbi_info(name.c_str(), &columns, &rows, &channels) || columns <= 0 || rows <= 0) {
     throw InvalidInputError(name,

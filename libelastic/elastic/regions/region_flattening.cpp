@@ -23,7 +23,9 @@ int count_folds(const Region& region, const std::vector<Eigen::Vector2d>& uv) {
   for (const Eigen::Vector3i& t : region.triangles) {
     const Eigen::Vector2d a = uv[static_cast<size_t>(t[1])] - uv[static_cast<size_t>(t[0])];
     const Eigen::Vector2d b = uv[static_cast<size_t>(t[2])] - uv[static_cast<size_t>(t[0])];
-    if (a.x() * b.y() - a.y() * b.x() <= 0.0) ++folds;
+    if (a.x() * b.y() - a.y() * b.x() <= 0.0) {
+      ++folds;
+    }
   }
   return folds;
 }
@@ -42,7 +44,9 @@ RegionFlattening flatten_disk(const Region& region) {
   const SurfaceCurve curve = region.boundary_curve();
   const std::vector<double> cum = curve.arc_lengths();
   const double total = curve.length();
-  if (!(total > 0.0)) throw NumericalError(name, "flattening: the boundary has zero length");
+  if (!(total > 0.0)) {
+    throw NumericalError(name, "flattening: the boundary has zero length");
+  }
   for (size_t k = 0; k < region.boundary.size(); ++k) {
     const double angle = 2.0 * std::numbers::pi * (cum[k] / total - region.anchor);
     uv[static_cast<size_t>(region.boundary[k])] = Eigen::Vector2d(std::cos(angle), std::sin(angle));
@@ -50,7 +54,9 @@ RegionFlattening flatten_disk(const Region& region) {
   }
   int free = 0;
   for (int v = 0; v < nv; ++v) {
-    if (index[static_cast<size_t>(v)] == -1) index[static_cast<size_t>(v)] = free++;
+    if (index[static_cast<size_t>(v)] == -1) {
+      index[static_cast<size_t>(v)] = free++;
+    }
   }
   RegionFlattening out;
   out.method = FlatteningMethod::Disk;
@@ -64,13 +70,19 @@ RegionFlattening flatten_disk(const Region& region) {
         const Eigen::Vector3d eij = region.positions[static_cast<size_t>(j)] - xi;
         const Eigen::Vector3d eil = region.positions[static_cast<size_t>(l)] - xi;
         const double lij = eij.norm(), lil = eil.norm();
-        if (lij == 0.0 || lil == 0.0) continue;
+        if (lij == 0.0 || lil == 0.0) {
+          continue;
+        }
         // tan(a/2) = (1 - cos a) / sin a = |e1 x e2| ... written as (|e1||e2| - e1.e2) / |e1 x e2|.
         const double cross = eij.cross(eil).norm();
-        if (cross == 0.0) continue;
+        if (cross == 0.0) {
+          continue;
+        }
         const double tan_half = (lij * lil - eij.dot(eil)) / cross;
         const int ri = index[static_cast<size_t>(i)];
-        if (ri < 0) continue;
+        if (ri < 0) {
+          continue;
+        }
         // The angle at i in this triangle contributes to the weights of both edges (i,j) and (i,l).
         for (const auto& [other, len] : {std::pair{j, lij}, std::pair{l, lil}}) {
           const double w = tan_half / len;
@@ -97,7 +109,9 @@ RegionFlattening flatten_disk(const Region& region) {
     }
     for (int v = 0; v < nv; ++v) {
       const int r = index[static_cast<size_t>(v)];
-      if (r >= 0) uv[static_cast<size_t>(v)] = x.row(r).transpose();
+      if (r >= 0) {
+        uv[static_cast<size_t>(v)] = x.row(r).transpose();
+      }
     }
   }
   out.uv = std::move(uv);
@@ -116,7 +130,9 @@ RegionFlattening flatten_conformal(const Region& region) {
   const std::string name = region_name(region);
   const SurfaceCurve curve = region.boundary_curve();
   const auto nb = static_cast<int>(region.boundary.size());
-  if (nb < 3) throw NumericalError(name, "flattening: the boundary has fewer than 3 vertices");
+  if (nb < 3) {
+    throw NumericalError(name, "flattening: the boundary has fewer than 3 vertices");
+  }
   const std::vector<double> cum = curve.arc_lengths();
   const double total = curve.length();
   auto nearest_vertex = [&](double s) {
@@ -135,7 +151,9 @@ RegionFlattening flatten_conformal(const Region& region) {
   };
   const int pin0 = nearest_vertex(region.anchor);
   int pin1 = nearest_vertex(region.anchor + 0.5);
-  if (pin1 == pin0) pin1 = region.boundary[static_cast<size_t>(1)];
+  if (pin1 == pin0) {
+    pin1 = region.boundary[static_cast<size_t>(1)];
+  }
   const double pin_distance =
       (region.positions[static_cast<size_t>(pin1)] - region.positions[static_cast<size_t>(pin0)])
           .norm();
@@ -150,7 +168,9 @@ RegionFlattening flatten_conformal(const Region& region) {
       const Eigen::Vector3d b =
           region.positions[static_cast<size_t>(j)] - region.positions[static_cast<size_t>(l)];
       const double cross = a.cross(b).norm();
-      if (cross == 0.0) continue;
+      if (cross == 0.0) {
+        continue;
+      }
       // Edge (i, j) opposite corner l: 1/2 cot(l) (|u_i - u_j|^2 + |v_i - v_j|^2) enters E_D with
       // 1/2.
       const double w = 0.25 * a.dot(b) / cross;
@@ -180,14 +200,18 @@ RegionFlattening flatten_conformal(const Region& region) {
   int free = 0;
   for (int r = 0; r < 2 * nv; ++r) {
     const int v = r % nv;
-    if (v != pin0 && v != pin1) index[static_cast<size_t>(r)] = free++;
+    if (v != pin0 && v != pin1) {
+      index[static_cast<size_t>(r)] = free++;
+    }
   }
   Triplets reduced;
   Eigen::VectorXd rhs = Eigen::VectorXd::Zero(free);
   for (int c = 0; c < full.outerSize(); ++c) {
     for (Eigen::SparseMatrix<double>::InnerIterator it(full, c); it; ++it) {
       const int r = index[static_cast<size_t>(it.row())], cc = index[static_cast<size_t>(it.col())];
-      if (r < 0) continue;
+      if (r < 0) {
+        continue;
+      }
       if (cc >= 0) {
         reduced.emplace_back(r, cc, it.value());
       } else {
@@ -198,8 +222,9 @@ RegionFlattening flatten_conformal(const Region& region) {
   Eigen::SparseMatrix<double> a(free, free);
   a.setFromTriplets(reduced.begin(), reduced.end());
   Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver(a);
-  if (solver.info() != Eigen::Success)
+  if (solver.info() != Eigen::Success) {
     throw NumericalError(name, "flattening: the LSCM system is singular");
+  }
   const Eigen::VectorXd x = solver.solve(rhs);
   if (solver.info() != Eigen::Success || !x.allFinite()) {
     throw NumericalError(name, "flattening: the LSCM solve failed");
@@ -221,7 +246,9 @@ RegionFlattening flatten_conformal(const Region& region) {
   }
   if (area2d > 0.0) {
     const double s = std::sqrt(region.area() / area2d);
-    for (auto& p : uv) p *= s;
+    for (auto& p : uv) {
+      p *= s;
+    }
   }
   RegionFlattening out;
   out.uv = std::move(uv);
@@ -238,7 +265,9 @@ RegionFlattening flatten_region(const Region& region, const FlatteningOptions& o
   }
   if (options.method == FlatteningMethod::Conformal) {
     RegionFlattening conformal = flatten_conformal(region);
-    if (conformal.folded_triangles == 0) return conformal;
+    if (conformal.folded_triangles == 0) {
+      return conformal;
+    }
     // Folded: fall back to the always-bijective disk map (method says which one was used).
   }
   return flatten_disk(region);

@@ -27,7 +27,9 @@ constexpr double kSnap = 1e-3;
 
 std::string trim(std::string_view s) {
   const auto b = s.find_first_not_of(" \t\r\n");
-  if (b == std::string_view::npos) return {};
+  if (b == std::string_view::npos) {
+    return {};
+  }
   const auto e = s.find_last_not_of(" \t\r\n");
   return std::string(s.substr(b, e - b + 1));
 }
@@ -57,15 +59,21 @@ std::vector<double> parse_numbers(const std::string& text, const std::string& fl
 /// Reads rows of `columns` numbers (blank lines and '#' comments skipped).
 std::vector<Eigen::VectorXd> read_rows(const std::string& path, int columns) {
   std::ifstream in(path);
-  if (!in) throw IoError(path, "cannot open the file");
+  if (!in) {
+    throw IoError(path, "cannot open the file");
+  }
   std::vector<Eigen::VectorXd> rows;
   std::string line;
   int number = 0;
   while (std::getline(in, line)) {
     ++number;
     const auto hash = line.find('#');
-    if (hash != std::string::npos) line.erase(hash);
-    if (trim(line).empty()) continue;
+    if (hash != std::string::npos) {
+      line.erase(hash);
+    }
+    if (trim(line).empty()) {
+      continue;
+    }
     std::istringstream ls(line);
     Eigen::VectorXd row(columns);
     for (int c = 0; c < columns; ++c) {
@@ -94,7 +102,9 @@ std::vector<Eigen::VectorXd> read_rows(const std::string& path, int columns) {
     }
     rows.push_back(row);
   }
-  if (in.bad()) throw IoError(path, "read error");
+  if (in.bad()) {
+    throw IoError(path, "read error");
+  }
   return rows;
 }
 
@@ -133,23 +143,30 @@ struct Context {
     for (int t : face_triangles[static_cast<size_t>(p.face)]) {
       const Eigen::Vector3d b =
           regions_detail::barycentric_2d(corner_uv[static_cast<size_t>(t)], p.uv());
-      if (b.isZero()) continue;
+      if (b.isZero()) {
+        continue;
+      }
       if (b.minCoeff() > best_min) {
         best_min = b.minCoeff();
         best = MeshLocation{t, b};
       }
     }
-    if (best.triangle < 0)
+    if (best.triangle < 0) {
       throw NumericalError(options.name, "internal: cannot locate a surface point");
+    }
     Eigen::Vector3d b = best.bary.cwiseMax(0.0);
-    for (int k = 0; k < 3; ++k) b[k] = b[k] < 1e-9 ? 0.0 : b[k];
+    for (int k = 0; k < 3; ++k) {
+      b[k] = b[k] < 1e-9 ? 0.0 : b[k];
+    }
     best.bary = b / b.sum();
     return best;
   }
 
   /// Projects a user point onto the surface; error when it is far from it.
   MeshLocation project(const Eigen::Vector3d& x, const std::string& what) const {
-    if (!x.allFinite()) throw InvalidInputError(options.name, what + " is not finite");
+    if (!x.allFinite()) {
+      throw InvalidInputError(options.name, what + " is not finite");
+    }
     const ClosestPoint cp = projector.closest(x);
     if (cp.distance > options.max_point_distance * diagonal) {
       std::ostringstream msg;
@@ -177,19 +194,29 @@ Region pick_disk_side(const CutMesh& cut, const std::string& name) {
     bool adjacent = false;
     for (int t : comps[c]) {
       const Eigen::Vector3i& v = cut.triangles[static_cast<size_t>(t)];
-      for (int k = 0; k < 3 && !adjacent; ++k) adjacent = cut.is_curve_edge(v[k], v[(k + 1) % 3]);
-      if (adjacent) break;
+      for (int k = 0; k < 3 && !adjacent; ++k) {
+        adjacent = cut.is_curve_edge(v[k], v[(k + 1) % 3]);
+      }
+      if (adjacent) {
+        break;
+      }
     }
-    if (!adjacent) continue;
+    if (!adjacent) {
+      continue;
+    }
     ++touching;
     PatchTopology topo = regions_detail::patch_topology(cut, comps[c]);
-    if (!topo.is_disk()) continue;
+    if (!topo.is_disk()) {
+      continue;
+    }
     if (best < 0 || topo.area < best_topo.area) {
       best = static_cast<int>(c);
       best_topo = std::move(topo);
     }
   }
-  if (best < 0 || touching < 2) throw_not_disk(name);
+  if (best < 0 || touching < 2) {
+    throw_not_disk(name);
+  }
   return regions_detail::make_region_from_patch(cut, comps[static_cast<size_t>(best)], best_topo);
 }
 
@@ -207,16 +234,20 @@ Region disk_region(const Context& ctx, const RegionSpec& spec) {
   // where the linear interpolant vanishes. Crossings within kSnap of an end move to that end (phi
   // := 0 there).
   std::vector<double> phi(distance.data(), distance.data() + distance.size());
-  for (double& p : phi) p -= spec.radius;
+  for (double& p : phi) {
+    p -= spec.radius;
+  }
   const std::vector<double> raw = phi;
   std::vector<std::pair<int, int>> edges;
   for (const Eigen::Vector3i& t : ctx.tess.triangles) {
     for (int k = 0; k < 3; ++k) {
       const int a = t[k], b = t[(k + 1) % 3];
-      if (a < b) edges.emplace_back(a, b);
-      // Boundary edges appear once, in one direction only.
-      else if (cut.edge_triangles(a, b).size() == 1)
+      if (a < b) {
+        edges.emplace_back(a, b);
+        // Boundary edges appear once, in one direction only.
+      } else if (cut.edge_triangles(a, b).size() == 1) {
         edges.emplace_back(b, a);
+      }
     }
   }
   std::sort(edges.begin(), edges.end());
@@ -224,17 +255,27 @@ Region disk_region(const Context& ctx, const RegionSpec& spec) {
   std::vector<char> zero(phi.size(), 0);
   for (const auto& [a, b] : edges) {
     const double pa = phi[static_cast<size_t>(a)], pb = phi[static_cast<size_t>(b)];
-    if (!((pa < 0.0 && pb > 0.0) || (pa > 0.0 && pb < 0.0))) continue;
+    if (!((pa < 0.0 && pb > 0.0) || (pa > 0.0 && pb < 0.0))) {
+      continue;
+    }
     const double t = pa / (pa - pb);
-    if (t < kSnap) zero[static_cast<size_t>(a)] = 1;
-    if (t > 1.0 - kSnap) zero[static_cast<size_t>(b)] = 1;
+    if (t < kSnap) {
+      zero[static_cast<size_t>(a)] = 1;
+    }
+    if (t > 1.0 - kSnap) {
+      zero[static_cast<size_t>(b)] = 1;
+    }
   }
   for (size_t i = 0; i < phi.size(); ++i) {
-    if (zero[i]) phi[i] = 0.0;
+    if (zero[i]) {
+      phi[i] = 0.0;
+    }
   }
   for (const auto& [a, b] : edges) {
     const double pa = phi[static_cast<size_t>(a)], pb = phi[static_cast<size_t>(b)];
-    if (!((pa < 0.0 && pb > 0.0) || (pa > 0.0 && pb < 0.0))) continue;
+    if (!((pa < 0.0 && pb > 0.0) || (pa > 0.0 && pb < 0.0))) {
+      continue;
+    }
     cut.split_edge(a, b, pa / (pa - pb));
     phi.push_back(0.0);
   }
@@ -246,13 +287,16 @@ Region disk_region(const Context& ctx, const RegionSpec& spec) {
     double max_phi = -std::numeric_limits<double>::infinity(), raw_sum = 0.0;
     for (int k = 0; k < 3; ++k) {
       max_phi = std::max(max_phi, phi[static_cast<size_t>(v[k])]);
-      if (static_cast<size_t>(v[k]) < raw.size()) raw_sum += raw[static_cast<size_t>(v[k])];
+      if (static_cast<size_t>(v[k]) < raw.size()) {
+        raw_sum += raw[static_cast<size_t>(v[k])];
+      }
     }
     inside[static_cast<size_t>(t)] = max_phi < 0.0;
     if (max_phi == 0.0) {
       bool any_negative = false;
-      for (int k = 0; k < 3; ++k)
+      for (int k = 0; k < 3; ++k) {
         any_negative = any_negative || phi[static_cast<size_t>(v[k])] < 0.0;
+      }
       inside[static_cast<size_t>(t)] = any_negative || raw_sum < 0.0;
     }
   }
@@ -278,7 +322,9 @@ Region disk_region(const Context& ctx, const RegionSpec& spec) {
     throw InvalidInputError(name, "the disk of radius " + std::to_string(spec.radius) +
                                       " covers the whole closed surface");
   }
-  if (!topo.is_disk()) throw_not_disk(name);
+  if (!topo.is_disk()) {
+    throw_not_disk(name);
+  }
   return regions_detail::make_region_from_patch(cut, comps[static_cast<size_t>(chosen)], topo);
 }
 
@@ -321,8 +367,12 @@ void embed_curve(CutMesh& cut, const std::vector<MeshLocation>& nodes, Chart cha
       continue;
     }
     // The last path may end on the first point (a trace that reaches it within the snap distance).
-    if (i + 1 == nodes.size() && verts.size() > 1 && v == verts.front()) break;
-    if (cut.on_curve[static_cast<size_t>(v)]) cut.throw_crossing();
+    if (i + 1 == nodes.size() && verts.size() > 1 && v == verts.front()) {
+      break;
+    }
+    if (cut.on_curve[static_cast<size_t>(v)]) {
+      cut.throw_crossing();
+    }
     cut.on_curve[static_cast<size_t>(v)] = 1;
     verts.push_back(v);
     seg.push_back(n.triangle);
@@ -332,7 +382,9 @@ void embed_curve(CutMesh& cut, const std::vector<MeshLocation>& nodes, Chart cha
     const Eigen::Vector2d want = chart_points ? (*chart_points)[i] : Eigen::Vector2d::Zero();
     for (int t : cut.vertex_triangles[static_cast<size_t>(v)]) {
       if (chart == Chart::Ptex) {
-        if (cut.face[static_cast<size_t>(t)] != cut.face[static_cast<size_t>(n.triangle)]) continue;
+        if (cut.face[static_cast<size_t>(t)] != cut.face[static_cast<size_t>(n.triangle)]) {
+          continue;
+        }
         c = cut.chart_coordinate(chart, t, v);
         best = 0.0;
         break;
@@ -373,7 +425,9 @@ Region points_region(const Context& ctx, const RegionSpec& spec) {
       x += loc.bary[k] * ctx.tess.positions[static_cast<size_t>(
                              ctx.tess.triangles[static_cast<size_t>(loc.triangle)][k])];
     }
-    if (!where.empty() && (x - where.back()).norm() <= 1e-9 * ctx.diagonal) continue;
+    if (!where.empty() && (x - where.back()).norm() <= 1e-9 * ctx.diagonal) {
+      continue;
+    }
     where.push_back(x);
     locs.push_back(loc);
   }
@@ -397,7 +451,9 @@ Region points_region(const Context& ctx, const RegionSpec& spec) {
       const Eigen::Vector3i& to = ctx.tess.triangles[static_cast<size_t>(node.segment_triangle)];
       for (int k = 0; k < 3; ++k) {
         for (int l = 0; l < 3; ++l) {
-          if (to[l] == from[k]) m.bary[l] += node.location.bary[k];
+          if (to[l] == from[k]) {
+            m.bary[l] += node.location.bary[k];
+          }
         }
       }
       m.bary /= m.bary.sum();
@@ -412,14 +468,18 @@ Region points_region(const Context& ctx, const RegionSpec& spec) {
 Region boundary_region(const Context& ctx) {
   CutMesh cut = ctx.cut_mesh();
   std::vector<int> all(static_cast<size_t>(cut.num_triangles()));
-  for (int t = 0; t < cut.num_triangles(); ++t) all[static_cast<size_t>(t)] = t;
+  for (int t = 0; t < cut.num_triangles(); ++t) {
+    all[static_cast<size_t>(t)] = t;
+  }
   const PatchTopology topo = regions_detail::patch_topology(cut, all);
   if (topo.loops.size() != 1) {
     throw InvalidInputError(ctx.options.name,
                             "'boundary' needs a surface with exactly one boundary loop; " +
                                 ctx.surface.name() + " has " + std::to_string(topo.loops.size()));
   }
-  if (!topo.is_disk()) throw_not_disk(ctx.options.name);
+  if (!topo.is_disk()) {
+    throw_not_disk(ctx.options.name);
+  }
   return regions_detail::make_region_from_patch(cut, all, topo);
 }
 
@@ -442,10 +502,16 @@ Region uv_region(const Context& ctx, const RegionSpec& spec) {
   }
   std::vector<Eigen::Vector2d> poly;
   for (const Eigen::Vector2d& p : spec.uv_polygon) {
-    if (!p.allFinite()) throw InvalidInputError(name, "uv polygon point is not finite");
-    if (poly.empty() || (p - poly.back()).norm() > 1e-12) poly.push_back(p);
+    if (!p.allFinite()) {
+      throw InvalidInputError(name, "uv polygon point is not finite");
+    }
+    if (poly.empty() || (p - poly.back()).norm() > 1e-12) {
+      poly.push_back(p);
+    }
   }
-  if (poly.size() > 1 && (poly.back() - poly.front()).norm() <= 1e-12) poly.pop_back();
+  if (poly.size() > 1 && (poly.back() - poly.front()).norm() <= 1e-12) {
+    poly.pop_back();
+  }
   if (poly.size() < 3) {
     throw InvalidInputError(name, "the uv polygon needs at least 3 distinct points, got " +
                                       std::to_string(poly.size()));
@@ -453,7 +519,9 @@ Region uv_region(const Context& ctx, const RegionSpec& spec) {
   const size_t n = poly.size();
   for (size_t i = 0; i < n; ++i) {
     for (size_t j = i + 1; j < n; ++j) {
-      if (j == i + 1 || (i == 0 && j == n - 1)) continue;  // neighbours share a corner
+      if (j == i + 1 || (i == 0 && j == n - 1)) {
+        continue;  // neighbours share a corner
+      }
       if (segments_cross(poly[i], poly[(i + 1) % n], poly[j], poly[(j + 1) % n])) {
         throw InvalidInputError(name, "the curve crosses itself (uv polygon edges " +
                                           std::to_string(i + 1) + " and " + std::to_string(j + 1) +
@@ -469,7 +537,9 @@ Region uv_region(const Context& ctx, const RegionSpec& spec) {
     double best_min = -1e-9;
     for (int t = 0; t < cut.num_triangles(); ++t) {
       const Eigen::Vector3d b = regions_detail::barycentric_2d(cut.tex[static_cast<size_t>(t)], p);
-      if (b.isZero()) continue;
+      if (b.isZero()) {
+        continue;
+      }
       if (b.minCoeff() > best_min) {
         best_min = b.minCoeff();
         best = MeshLocation{t, b.cwiseMax(0.0) / b.cwiseMax(0.0).sum()};
@@ -503,7 +573,9 @@ double automatic_anchor(const Region& region) {
     area += 0.5 * n.norm();
     centroid += 0.5 * n.norm() * (a + b + c) / 3.0;
   }
-  if (area > 0.0) centroid /= area;
+  if (area > 0.0) {
+    centroid /= area;
+  }
   Eigen::Vector3d reference = Eigen::Vector3d::UnitX();
   if (normal.norm() > 1e-9 * area) {
     const Eigen::Vector3d nn = normal.normalized();
@@ -540,7 +612,9 @@ RegionSpec parse_region_spec(std::string_view text_in, std::string_view flag_in)
   const auto semi = text.find(";anchor=");
   if (semi != std::string::npos) {
     const auto values = parse_numbers(text.substr(semi + 8), flag, "anchor");
-    if (values.size() != 3) throw InvalidInputError(flag, "anchor needs X,Y,Z");
+    if (values.size() != 3) {
+      throw InvalidInputError(flag, "anchor needs X,Y,Z");
+    }
     spec.anchor = Eigen::Vector3d(values[0], values[1], values[2]);
     text = trim(text.substr(0, semi));
   }
@@ -551,23 +625,35 @@ RegionSpec parse_region_spec(std::string_view text_in, std::string_view flag_in)
     spec.kind = RegionSpec::Kind::Boundary;
   } else if (kind == "disk") {
     const auto values = parse_numbers(arg, flag, "disk");
-    if (values.size() != 4) throw InvalidInputError(flag, "disk needs X,Y,Z,R, got '" + arg + "'");
+    if (values.size() != 4) {
+      throw InvalidInputError(flag, "disk needs X,Y,Z,R, got '" + arg + "'");
+    }
     spec.kind = RegionSpec::Kind::Disk;
     spec.center = Eigen::Vector3d(values[0], values[1], values[2]);
     spec.radius = values[3];
-    if (!(spec.radius > 0.0)) throw InvalidInputError(flag, "disk radius must be positive");
+    if (!(spec.radius > 0.0)) {
+      throw InvalidInputError(flag, "disk radius must be positive");
+    }
   } else if (kind == "points") {
-    if (arg.empty()) throw InvalidInputError(flag, "points: needs a file name");
+    if (arg.empty()) {
+      throw InvalidInputError(flag, "points: needs a file name");
+    }
     spec.kind = RegionSpec::Kind::Points;
-    for (const auto& row : read_rows(arg, 3)) spec.points.emplace_back(row[0], row[1], row[2]);
+    for (const auto& row : read_rows(arg, 3)) {
+      spec.points.emplace_back(row[0], row[1], row[2]);
+    }
     if (spec.points.size() < 3) {
       throw InvalidInputError(arg, "a points curve needs at least 3 points, the file has " +
                                        std::to_string(spec.points.size()));
     }
   } else if (kind == "uv") {
-    if (arg.empty()) throw InvalidInputError(flag, "uv: needs a file name");
+    if (arg.empty()) {
+      throw InvalidInputError(flag, "uv: needs a file name");
+    }
     spec.kind = RegionSpec::Kind::UvPolygon;
-    for (const auto& row : read_rows(arg, 2)) spec.uv_polygon.emplace_back(row[0], row[1]);
+    for (const auto& row : read_rows(arg, 2)) {
+      spec.uv_polygon.emplace_back(row[0], row[1]);
+    }
     if (spec.uv_polygon.size() < 3) {
       throw InvalidInputError(arg, "a uv polygon needs at least 3 points, the file has " +
                                        std::to_string(spec.uv_polygon.size()));
@@ -599,7 +685,9 @@ Region make_region(const SurfaceProjector& projector, const RegionSpec& spec,
       break;
   }
   if (spec.anchor) {
-    if (!spec.anchor->allFinite()) throw InvalidInputError(options.name, "anchor is not finite");
+    if (!spec.anchor->allFinite()) {
+      throw InvalidInputError(options.name, "anchor is not finite");
+    }
     region.anchor = region.boundary_curve().nearest_arc_parameter(*spec.anchor);
   } else {
     region.anchor = automatic_anchor(region);

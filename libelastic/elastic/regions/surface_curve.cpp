@@ -32,9 +32,13 @@ SurfaceCurve::Location SurfaceCurve::locate(double s, const std::vector<double>&
                                             double total) const {
   Location loc;
   const int n = size();
-  if (n == 0) return loc;
+  if (n == 0) {
+    return loc;
+  }
   loc.position = positions.front();
-  if (n == 1 || total == 0.0) return loc;
+  if (n == 1 || total == 0.0) {
+    return loc;
+  }
   // Normalised arc length from vertex 0, wrapped into [0, 1).
   double w = anchor + s;
   w -= std::floor(w);
@@ -54,7 +58,9 @@ SurfaceCurve::Location SurfaceCurve::locate(double s, const std::vector<double>&
 double SurfaceCurve::nearest_arc_parameter(const Eigen::Vector3d& x) const {
   const int n = size();
   const double total = length();
-  if (n < 2 || total == 0.0) return 0.0;
+  if (n < 2 || total == 0.0) {
+    return 0.0;
+  }
   const std::vector<double> cum = arc_lengths();
   double best = std::numeric_limits<double>::infinity(), best_arc = 0.0;
   for (int i = 0; i < n; ++i) {

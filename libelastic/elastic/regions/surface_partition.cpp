@@ -23,7 +23,9 @@ int locate_in_face(const std::vector<std::vector<int>>& face_triangles,
   double best_min = -std::numeric_limits<double>::infinity();
   for (int t : face_triangles[static_cast<size_t>(face)]) {
     const Eigen::Vector3d b = barycentric_2d(corner_uv[static_cast<size_t>(t)], uv);
-    if (b.isZero()) continue;
+    if (b.isZero()) {
+      continue;
+    }
     if (b.minCoeff() > best_min) {
       best_min = b.minCoeff();
       best = t;
@@ -38,7 +40,9 @@ int locate_in_children(const CutMesh& cut, int origin, const Eigen::Vector2d& uv
   double best_min = -std::numeric_limits<double>::infinity();
   for (int t : cut.children[static_cast<size_t>(origin)]) {
     const Eigen::Vector3d b = barycentric_2d(cut.uv[static_cast<size_t>(t)], uv);
-    if (b.isZero()) continue;
+    if (b.isZero()) {
+      continue;
+    }
     if (b.minCoeff() > best_min) {
       best_min = b.minCoeff();
       best = t;
@@ -50,7 +54,9 @@ int locate_in_children(const CutMesh& cut, int origin, const Eigen::Vector2d& uv
 Eigen::Vector2d corner_uv_of(const Region& region, int t, int v) {
   const Eigen::Vector3i& tri = region.triangles[static_cast<size_t>(t)];
   for (int k = 0; k < 3; ++k) {
-    if (tri[k] == v) return region.triangle_uv[static_cast<size_t>(t)][static_cast<size_t>(k)];
+    if (tri[k] == v) {
+      return region.triangle_uv[static_cast<size_t>(t)][static_cast<size_t>(k)];
+    }
   }
   return region.points[static_cast<size_t>(v)].uv();
 }
@@ -88,7 +94,9 @@ SurfacePartition partition_surface(const LimitSurface& surface, const LimitTesse
   std::map<std::pair<int, int>, int> directed;
   for (int t = 0; t < region.num_triangles(); ++t) {
     const Eigen::Vector3i& tri = region.triangles[static_cast<size_t>(t)];
-    for (int k = 0; k < 3; ++k) directed[{tri[k], tri[(k + 1) % 3]}] = t;
+    for (int k = 0; k < 3; ++k) {
+      directed[{tri[k], tri[(k + 1) % 3]}] = t;
+    }
   }
   struct Node {
     int vertex;
@@ -107,11 +115,19 @@ SurfacePartition partition_surface(const LimitSurface& surface, const LimitTesse
     const int face = region.triangle_face[static_cast<size_t>(t)];
     const Eigen::Vector2d uv = corner_uv_of(region, t, a);
     const int origin = locate_in_face(face_triangles, corner_uv, face, uv);
-    if (origin < 0) throw NumericalError(name, "cannot locate a boundary point on the surface");
+    if (origin < 0) {
+      throw NumericalError(name, "cannot locate a boundary point on the surface");
+    }
     const int v = cut.insert_point(origin, uv, options.snap);
-    if (!nodes.empty() && nodes.back().vertex == v) continue;  // merged by the snap
-    if (k + 1 == n && nodes.size() > 1 && nodes.front().vertex == v) break;
-    if (cut.on_curve[static_cast<size_t>(v)]) cut.throw_crossing();
+    if (!nodes.empty() && nodes.back().vertex == v) {
+      continue;  // merged by the snap
+    }
+    if (k + 1 == n && nodes.size() > 1 && nodes.front().vertex == v) {
+      break;
+    }
+    if (cut.on_curve[static_cast<size_t>(v)]) {
+      cut.throw_crossing();
+    }
     cut.on_curve[static_cast<size_t>(v)] = 1;
     // Chart coordinate of the (possibly snapped) vertex in the segment's face.
     Eigen::Vector2d coord = uv;
@@ -155,7 +171,9 @@ SurfacePartition partition_surface(const LimitSurface& surface, const LimitTesse
   const int centre_origin = locate_in_face(face_triangles, corner_uv, centre_face, centre);
   const int centre_triangle =
       centre_origin < 0 ? -1 : locate_in_children(cut, centre_origin, centre);
-  if (centre_triangle < 0) throw NumericalError(name, "cannot locate the region's interior");
+  if (centre_triangle < 0) {
+    throw NumericalError(name, "cannot locate the region's interior");
+  }
 
   const auto comps = cut.components();
   int inside = -1;
@@ -188,15 +206,21 @@ SurfacePartition partition_surface(const LimitSurface& surface, const LimitTesse
     for (size_t i = 0; i < sorted.size(); ++i) {
       const Eigen::Vector3i& from = cut.triangles[static_cast<size_t>(sorted[i])];
       const Eigen::Vector3i& to = out.inside.triangles[i];
-      for (int k = 0; k < 3; ++k) out.inside_vertices[static_cast<size_t>(to[k])] = from[k];
+      for (int k = 0; k < 3; ++k) {
+        out.inside_vertices[static_cast<size_t>(to[k])] = from[k];
+      }
     }
   }
   out.positions = cut.positions;
   out.points = cut.points;
   std::vector<char> in_inside(static_cast<size_t>(cut.num_triangles()), 0);
-  for (int t : comps[static_cast<size_t>(inside)]) in_inside[static_cast<size_t>(t)] = 1;
+  for (int t : comps[static_cast<size_t>(inside)]) {
+    in_inside[static_cast<size_t>(t)] = 1;
+  }
   for (int t = 0; t < cut.num_triangles(); ++t) {
-    if (in_inside[static_cast<size_t>(t)]) continue;
+    if (in_inside[static_cast<size_t>(t)]) {
+      continue;
+    }
     out.outside_triangles.push_back(cut.triangles[static_cast<size_t>(t)]);
     out.outside_face.push_back(cut.face[static_cast<size_t>(t)]);
     out.outside_uv.push_back(cut.uv[static_cast<size_t>(t)]);

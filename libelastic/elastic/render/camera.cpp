@@ -31,7 +31,9 @@ void check_fov_and_size(double fov_deg, int width, int height) {
 Eigen::Vector3d most_orthogonal_axis(const Eigen::Vector3d& v) {
   int best = 1;
   for (int axis : {2, 0}) {
-    if (std::abs(v[axis]) < std::abs(v[best])) best = axis;
+    if (std::abs(v[axis]) < std::abs(v[best])) {
+      best = axis;
+    }
   }
   return Eigen::Vector3d::Unit(best);
 }
@@ -107,7 +109,9 @@ Eigen::Vector3d orbit_view(const Eigen::Vector3d& view, double azimuth_deg, doub
   // Raise towards up: rotate about turned x up (positive angles move the view towards up). A view
   // along up has no such axis; it is returned turned only.
   const Eigen::Vector3d axis = turned.cross(n);
-  if (!(axis.norm() > 1e-12)) return turned;
+  if (!(axis.norm() > 1e-12)) {
+    return turned;
+  }
   return Eigen::AngleAxisd(elevation_deg * kDegree, axis.normalized()) * turned;
 }
 
@@ -130,7 +134,9 @@ Camera frame(const Eigen::AlignedBox3d& box, const std::vector<Eigen::Vector3d>&
   const Eigen::Vector3d w = view_direction.normalized();  // towards the eye
   Eigen::Vector3d up_hint =
       up.allFinite() && up.norm() > 0.0 ? up.normalized() : most_orthogonal_axis(w);
-  if (std::abs(up_hint.dot(w)) > std::cos(8.0 * kDegree)) up_hint = most_orthogonal_axis(w);
+  if (std::abs(up_hint.dot(w)) > std::cos(8.0 * kDegree)) {
+    up_hint = most_orthogonal_axis(w);
+  }
 
   Camera camera;
   camera.target = box.center();
@@ -172,7 +178,9 @@ Camera frame(const Eigen::AlignedBox3d& box, const std::vector<Eigen::Vector3d>&
     distance = std::max(distance, (point - centre).dot(w) + 0.01 * diagonal);
   }
   camera.target = centre + offset_x * right + offset_y * image_up;
-  if (!(diagonal > 0.0)) distance = 1.0;
+  if (!(diagonal > 0.0)) {
+    distance = 1.0;
+  }
   camera.eye = camera.target + distance * w;
   return camera;
 }
@@ -195,10 +203,14 @@ Camera frame_points(const std::vector<Eigen::Vector3d>& points,
                     double fill, const Eigen::Vector3d& up) {
   Eigen::AlignedBox3d box;
   for (const Eigen::Vector3d& p : points) {
-    if (!p.allFinite()) throw InvalidInputError("camera", "a point to frame is not finite");
+    if (!p.allFinite()) {
+      throw InvalidInputError("camera", "a point to frame is not finite");
+    }
     box.extend(p);
   }
-  if (points.empty()) throw InvalidInputError("camera", "no points to frame");
+  if (points.empty()) {
+    throw InvalidInputError("camera", "no points to frame");
+  }
   return frame(box, points, view_direction, fov_deg, width, height, fill, up);
 }
 

@@ -74,7 +74,9 @@ constexpr Glyph kGlyphs[] = {
 const Glyph& glyph(char c) {
   const char upper = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
   for (const Glyph& g : kGlyphs) {
-    if (g.c == upper) return g;
+    if (g.c == upper) {
+      return g;
+    }
   }
   return kGlyphs[std::size(kGlyphs) - 1];  // '?'
 }
@@ -87,8 +89,12 @@ void blend(Eigen::Vector4f& pixel, const Eigen::Vector4f& color) {
 
 Image compose(const std::vector<Image>& frames, int columns, const std::vector<std::string>& labels,
               const ComposeOptions& options, const std::string& name) {
-  if (frames.empty()) throw InvalidInputError(name, "no images to compose");
-  if (columns < 1) throw InvalidInputError(name, "columns must be at least 1");
+  if (frames.empty()) {
+    throw InvalidInputError(name, "no images to compose");
+  }
+  if (columns < 1) {
+    throw InvalidInputError(name, "columns must be at least 1");
+  }
   if (options.gap < 0 || options.text_scale < 0) {
     throw InvalidInputError(name, "gap and text scale must not be negative");
   }
@@ -124,7 +130,9 @@ Image compose(const std::vector<Image>& frames, int columns, const std::vector<s
     const Image& frame = frames[static_cast<size_t>(i)];
     const int fx = x0 + (cell_w - frame.width) / 2, fy = y0 + band;
     for (int y = 0; y < frame.height; ++y) {
-      for (int x = 0; x < frame.width; ++x) sheet.at(fx + x, fy + y) = frame.at(x, y);
+      for (int x = 0; x < frame.width; ++x) {
+        sheet.at(fx + x, fy + y) = frame.at(x, y);
+      }
     }
   }
   return sheet;
@@ -139,13 +147,17 @@ Eigen::Vector2i text_size(std::string_view text, int scale) {
 
 void draw_text(Image& image, int x, int y, std::string_view text, int scale,
                const Eigen::Vector4f& color) {
-  if (scale < 1) throw InvalidInputError("draw_text", "scale must be at least 1");
+  if (scale < 1) {
+    throw InvalidInputError("draw_text", "scale must be at least 1");
+  }
   for (size_t i = 0; i < text.size(); ++i) {
     const Glyph& g = glyph(text[i]);
     const int gx = x + static_cast<int>(i) * 6 * scale;
     for (int row = 0; row < 7; ++row) {
       for (int col = 0; col < 5; ++col) {
-        if (g.rows[static_cast<size_t>(row)][col] != '#') continue;
+        if (g.rows[static_cast<size_t>(row)][col] != '#') {
+          continue;
+        }
         for (int dy = 0; dy < scale; ++dy) {
           for (int dx = 0; dx < scale; ++dx) {
             const int px = gx + col * scale + dx, py = y + row * scale + dy;

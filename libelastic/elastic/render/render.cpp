@@ -39,7 +39,9 @@ struct EmbreeScene {
   RTCScene handle;
   explicit EmbreeScene(RTCDevice device) : handle(rtcNewScene(device)) {}
   ~EmbreeScene() {
-    if (handle) rtcReleaseScene(handle);
+    if (handle) {
+      rtcReleaseScene(handle);
+    }
   }
   EmbreeScene(const EmbreeScene&) = delete;
   EmbreeScene& operator=(const EmbreeScene&) = delete;
@@ -104,7 +106,9 @@ std::string object_name(size_t k) {
 void check_mesh(const PolygonMesh& mesh, size_t k) {
   const size_t nv = mesh.positions.size();
   for (const Eigen::Vector3d& p : mesh.positions) {
-    if (!p.allFinite()) bad_object(k, "a vertex position is not finite");
+    if (!p.allFinite()) {
+      bad_object(k, "a vertex position is not finite");
+    }
   }
   const int nf = mesh.num_faces();
   if (nf > 0) {
@@ -113,11 +117,15 @@ void check_mesh(const PolygonMesh& mesh, size_t k) {
       bad_object(k, "face offsets do not match the corner list");
     }
     for (int f = 0; f < nf; ++f) {
-      if (mesh.face_size(f) < 3) bad_object(k, "face " + std::to_string(f) + " has < 3 corners");
+      if (mesh.face_size(f) < 3) {
+        bad_object(k, "face " + std::to_string(f) + " has < 3 corners");
+      }
     }
   }
   for (int v : mesh.face_vertices) {
-    if (v < 0 || static_cast<size_t>(v) >= nv) bad_object(k, "a face index is out of range");
+    if (v < 0 || static_cast<size_t>(v) >= nv) {
+      bad_object(k, "a face index is out of range");
+    }
   }
   if (mesh.has_texcoords()) {
     if (mesh.corner_texcoords.size() != mesh.face_vertices.size()) {
@@ -185,16 +193,24 @@ void resolve_colors(PreparedObject& prepared, size_t k) {
                                                    : SurfaceColoring::Plain;
       return;
     case SurfaceColoring::FaceColors:
-      if (!mesh.has_face_colors()) bad_object(k, "has no face colours to show");
+      if (!mesh.has_face_colors()) {
+        bad_object(k, "has no face colours to show");
+      }
       break;
     case SurfaceColoring::VertexColors:
-      if (!mesh.has_vertex_colors()) bad_object(k, "has no vertex colours to show");
+      if (!mesh.has_vertex_colors()) {
+        bad_object(k, "has no vertex colours to show");
+      }
       break;
     case SurfaceColoring::Texture:
-      if (!textured) bad_object(k, "has no textured material with texture coordinates to show");
+      if (!textured) {
+        bad_object(k, "has no textured material with texture coordinates to show");
+      }
       break;
     case SurfaceColoring::Materials:
-      if (!has_materials) bad_object(k, "has no materials to show");
+      if (!has_materials) {
+        bad_object(k, "has no materials to show");
+      }
       break;
     case SurfaceColoring::Plain:
       break;
@@ -219,7 +235,9 @@ void compute_vertex_normals(PreparedObject& prepared) {
   prepared.vertex_normals.assign(mesh.positions.size(), Eigen::Vector3d::Zero());
   for (int f = 0; f < mesh.num_faces(); ++f) {
     const Eigen::Vector3d n = newell_normal(mesh, f);
-    for (int v : mesh.face(f)) prepared.vertex_normals[v] += n;
+    for (int v : mesh.face(f)) {
+      prepared.vertex_normals[v] += n;
+    }
   }
   for (Eigen::Vector3d& n : prepared.vertex_normals) {
     const double length = n.norm();
@@ -235,7 +253,9 @@ std::vector<std::pair<int, int>> polygon_edges(const PolygonMesh& mesh) {
     const std::span<const int> face = mesh.face(f);
     for (size_t i = 0; i < face.size(); ++i) {
       const int a = face[i], b = face[(i + 1) % face.size()];
-      if (a != b) edges.emplace_back(std::min(a, b), std::max(a, b));
+      if (a != b) {
+        edges.emplace_back(std::min(a, b), std::max(a, b));
+      }
     }
   }
   std::sort(edges.begin(), edges.end());
@@ -259,7 +279,9 @@ class Tracer {
         surfaces_(device_.handle),
         wires_(device_.handle) {
     const Eigen::AlignedBox3d box = bounding_box(scene);
-    if (!box.isEmpty()) shift_ = box.center();
+    if (!box.isEmpty()) {
+      shift_ = box.center();
+    }
     diagonal_ = box.isEmpty() ? 1.0 : std::max(box.diagonal().norm(), 1e-300);
     // World size of one pixel at the target's distance: the wire radius that gives the requested
     // screen width there (nearer wires look wider, farther ones thinner, as tubes do).
@@ -285,7 +307,9 @@ class Tracer {
         compute_vertex_normals(prepared);
         add_triangles(static_cast<int>(k));
       }
-      if (look.wireframe) add_curves(static_cast<int>(k));
+      if (look.wireframe) {
+        add_curves(static_cast<int>(k));
+      }
     }
     // Robust (watertight) triangle tests: no background pixels leaking through shared edges.
     rtcSetSceneFlags(surfaces_.handle, RTC_SCENE_FLAG_ROBUST);
@@ -318,12 +342,16 @@ class Tracer {
           prepared_[static_cast<size_t>(wire_objects_[wire.hit.geomID])];
       Eigen::Vector3d n(wire.hit.Ng_x, wire.hit.Ng_y, wire.hit.Ng_z);
       n = n.norm() > 0.0 ? Eigen::Vector3d(n.normalized()) : view;
-      if (n.dot(view) < 0.0) n = -n;
+      if (n.dot(view) < 0.0) {
+        n = -n;
+      }
       const Eigen::Vector3f c = prepared.object->look.wire_color;
       const auto light = static_cast<float>(lighting(n, 1.0));
       return {c.x() * light, c.y() * light, c.z() * light, 1.0f};
     }
-    if (query.hit.geomID == RTC_INVALID_GEOMETRY_ID) return background(py);
+    if (query.hit.geomID == RTC_INVALID_GEOMETRY_ID) {
+      return background(py);
+    }
 
     const PreparedObject& prepared =
         prepared_[static_cast<size_t>(surface_objects_[query.hit.geomID])];
@@ -344,10 +372,18 @@ class Tracer {
                                     .cross(mesh.positions[vertex[2]] - mesh.positions[vertex[0]]);
     geometric = geometric.norm() > 0.0 ? Eigen::Vector3d(geometric.normalized()) : view;
     // Two-sided: light the side the ray sees; keep the smooth normal on that side too.
-    if (geometric.dot(view) < 0.0) geometric = -geometric;
-    if (smooth.norm() > 0.0) smooth.normalize();
-    if (smooth.dot(geometric) < 0.0) smooth = -smooth;
-    if (smooth.norm() == 0.0) smooth = geometric;
+    if (geometric.dot(view) < 0.0) {
+      geometric = -geometric;
+    }
+    if (smooth.norm() > 0.0) {
+      smooth.normalize();
+    }
+    if (smooth.dot(geometric) < 0.0) {
+      smooth = -smooth;
+    }
+    if (smooth.norm() == 0.0) {
+      smooth = geometric;
+    }
 
     const double visibility = occlusion(point, geometric, random);
     const Eigen::Vector3f base = surface_color(prepared, face, corners, vertex, b);
@@ -374,7 +410,9 @@ class Tracer {
   }
 
   Eigen::Vector4f background(double py) const {
-    if (options_.transparent_background) return Eigen::Vector4f::Zero();
+    if (options_.transparent_background) {
+      return Eigen::Vector4f::Zero();
+    }
     const auto t = static_cast<float>(std::clamp(py / camera_.height, 0.0, 1.0));
     const Eigen::Vector3f c = (1.0f - t) * options_.background_top + t * options_.background_bottom;
     return {c.x(), c.y(), c.z(), 1.0f};
@@ -391,7 +429,9 @@ class Tracer {
   double occlusion(const Eigen::Vector3d& point, const Eigen::Vector3d& normal,
                    SampleRandom& random) const {
     const int count = options_.ambient_occlusion_samples;
-    if (count <= 0) return 1.0;
+    if (count <= 0) {
+      return 1.0;
+    }
     // Start the rays a little off the surface so they do not hit their own triangle through
     // single-precision round-off (1e-5 of the scene is ~100 float ulps of its extent).
     const double offset = 1e-5 * diagonal_;
@@ -414,7 +454,9 @@ class Tracer {
       rtcInitIntersectContext(&context);
       rtcOccluded1(surfaces_.handle, &context, &ray);  // wires cast no occlusion
       // Embree sets tfar to -inf when the ray is blocked.
-      if (ray.tfar >= 0.0f) ++open;
+      if (ray.tfar >= 0.0f) {
+        ++open;
+      }
     }
     return static_cast<double>(open) / count;
   }
@@ -434,15 +476,21 @@ class Tracer {
         return mesh.face_colors[face];
       case SurfaceColoring::VertexColors: {
         Eigen::Vector3f c = Eigen::Vector3f::Zero();
-        for (int i = 0; i < 3; ++i) c += static_cast<float>(b[i]) * mesh.vertex_colors[vertex[i]];
+        for (int i = 0; i < 3; ++i) {
+          c += static_cast<float>(b[i]) * mesh.vertex_colors[vertex[i]];
+        }
         return c;
       }
       case SurfaceColoring::Texture: {
         const Eigen::Vector3f under = material_color(prepared, face);
         const int m = mesh.face_materials[face];
-        if (m < 0 || (*prepared.textures)[m].empty()) return under;
+        if (m < 0 || (*prepared.textures)[m].empty()) {
+          return under;
+        }
         Eigen::Vector2d uv = Eigen::Vector2d::Zero();
-        for (int i = 0; i < 3; ++i) uv += b[i] * mesh.texcoords[mesh.corner_texcoords[corners[i]]];
+        for (int i = 0; i < 3; ++i) {
+          uv += b[i] * mesh.texcoords[mesh.corner_texcoords[corners[i]]];
+        }
         const Eigen::Vector4f texel = sample((*prepared.textures)[m], uv, ImageWrap::Repeat);
         // Straight alpha: the texel covers the material colour by its alpha.
         return texel.head<3>() * texel.w() + under * (1.0f - texel.w());
@@ -461,7 +509,9 @@ class Tracer {
     const unsigned id = rtcAttachGeometry((curve ? wires_ : surfaces_).handle, geometry);
     rtcReleaseGeometry(geometry);
     std::vector<int>& objects = curve ? wire_objects_ : surface_objects_;
-    if (objects.size() <= id) objects.resize(id + 1, -1);
+    if (objects.size() <= id) {
+      objects.resize(id + 1, -1);
+    }
     objects[id] = object;
   }
 
@@ -475,7 +525,9 @@ class Tracer {
         prepared.triangle_face.push_back(f);
       }
     }
-    if (prepared.triangle_corners.empty()) return;
+    if (prepared.triangle_corners.empty()) {
+      return;
+    }
     RTCGeometry geometry = rtcNewGeometry(device_.handle, RTC_GEOMETRY_TYPE_TRIANGLE);
     auto* vertices = static_cast<float*>(
         rtcSetNewGeometryBuffer(geometry, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
@@ -490,7 +542,9 @@ class Tracer {
     }
     for (size_t v = 0; v < mesh.positions.size(); ++v) {
       const Eigen::Vector3f p = to_float(mesh.positions[v] - shift_);
-      for (int c = 0; c < 3; ++c) vertices[3 * v + c] = p[c];
+      for (int c = 0; c < 3; ++c) {
+        vertices[3 * v + c] = p[c];
+      }
     }
     for (size_t t = 0; t < prepared.triangle_corners.size(); ++t) {
       for (int c = 0; c < 3; ++c) {
@@ -505,7 +559,9 @@ class Tracer {
     const PreparedObject& prepared = prepared_[static_cast<size_t>(k)];
     const PolygonMesh& mesh = prepared.object->mesh;
     const std::vector<std::pair<int, int>> edges = polygon_edges(mesh);
-    if (edges.empty()) return;
+    if (edges.empty()) {
+      return;
+    }
     // One two-vertex round linear curve (a capsule-like tube) per edge: vertices (x, y, z, radius).
     RTCGeometry geometry = rtcNewGeometry(device_.handle, RTC_GEOMETRY_TYPE_ROUND_LINEAR_CURVE);
     auto* vertices = static_cast<float*>(
@@ -571,26 +627,34 @@ void check_options(const RenderOptions& options) {
   if (!(options.wire_depth_tolerance >= 0.0) || !std::isfinite(options.wire_depth_tolerance)) {
     bad("wire depth tolerance must be a finite number >= 0");
   }
-  if (options.threads < 0) bad("thread count " + std::to_string(options.threads) + " is negative");
+  if (options.threads < 0) {
+    bad("thread count " + std::to_string(options.threads) + " is negative");
+  }
 }
 
 }  // namespace
 
 Eigen::AlignedBox3d bounding_box(const PolygonMesh& mesh) {
   Eigen::AlignedBox3d box;
-  for (const Eigen::Vector3d& p : mesh.positions) box.extend(p);
+  for (const Eigen::Vector3d& p : mesh.positions) {
+    box.extend(p);
+  }
   return box;
 }
 
 Eigen::AlignedBox3d bounding_box(const Scene& scene) {
   Eigen::AlignedBox3d box;
-  for (const SceneObject& object : scene.objects) box.extend(bounding_box(object.mesh));
+  for (const SceneObject& object : scene.objects) {
+    box.extend(bounding_box(object.mesh));
+  }
   return box;
 }
 
 Eigen::Vector3d vector_area(const PolygonMesh& mesh) {
   Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-  for (int f = 0; f < mesh.num_faces(); ++f) sum += newell_normal(mesh, f);
+  for (int f = 0; f < mesh.num_faces(); ++f) {
+    sum += newell_normal(mesh, f);
+  }
   return 0.5 * sum;
 }
 
@@ -646,7 +710,9 @@ Image render(const Scene& scene, const Camera& camera, const RenderOptions& opti
             }
             Eigen::Vector4f average = sum / static_cast<float>(samples);
             // Back from premultiplied alpha to the straight alpha Image stores.
-            if (average.w() > 0.0f) average.head<3>() /= average.w();
+            if (average.w() > 0.0f) {
+              average.head<3>() /= average.w();
+            }
             image.at(x, y) = average.cwiseMax(0.0f).cwiseMin(1.0f);
           }
         }

@@ -29,7 +29,9 @@ double corner_sine(const Eigen::Vector3d& xa, const Eigen::Vector3d& xc, const E
                    const Eigen::Vector3d& normal) {
   const Eigen::Vector3d e1 = xb - xc, e2 = xa - xc;
   const double scale = e1.norm() * e2.norm();
-  if (!(scale > 0.0)) return 0.0;
+  if (!(scale > 0.0)) {
+    return 0.0;
+  }
   return e1.cross(e2).dot(normal) / scale;
 }
 
@@ -38,23 +40,31 @@ double corner_sine(const Eigen::Vector3d& xa, const Eigen::Vector3d& xc, const E
 class RegionTexcoords {
  public:
   explicit RegionTexcoords(const Region& region) : region_(region) {
-    if (region.texcoords.empty()) return;
+    if (region.texcoords.empty()) {
+      return;
+    }
     for (int t = 0; t < region.num_triangles(); ++t) {
       const int f = region.triangle_face[t];
-      if (f >= static_cast<int>(by_face_.size())) by_face_.resize(f + 1);
+      if (f >= static_cast<int>(by_face_.size())) {
+        by_face_.resize(f + 1);
+      }
       by_face_[f].push_back(t);
     }
   }
   /// False (and `uv` untouched) when no triangle of the point's ptex face holds it.
   bool at(const SurfacePoint& p, Eigen::Vector2d& uv) const {
-    if (p.face < 0 || p.face >= static_cast<int>(by_face_.size())) return false;
+    if (p.face < 0 || p.face >= static_cast<int>(by_face_.size())) {
+      return false;
+    }
     int best = -1;
     Eigen::Vector3d best_w = Eigen::Vector3d::Zero();
     for (const int t : by_face_[p.face]) {
       const auto& c = region_.triangle_uv[t];
       const Eigen::Vector2d e1 = c[1] - c[0], e2 = c[2] - c[0], d = p.uv() - c[0];
       const double det = e1.x() * e2.y() - e1.y() * e2.x();
-      if (det == 0.0) continue;
+      if (det == 0.0) {
+        continue;
+      }
       const double b1 = (d.x() * e2.y() - d.y() * e2.x()) / det;
       const double b2 = (e1.x() * d.y() - e1.y() * d.x()) / det;
       const Eigen::Vector3d w(1.0 - b1 - b2, b1, b2);
@@ -65,7 +75,9 @@ class RegionTexcoords {
     }
     // A point slightly outside every triangle of its face (round-off on the region's edge) still
     // takes the nearest one; farther ones keep their previous UV.
-    if (best < 0 || best_w.minCoeff() < -1e-3) return false;
+    if (best < 0 || best_w.minCoeff() < -1e-3) {
+      return false;
+    }
     const Eigen::Vector3i& tri = region_.triangles[best];
     uv = best_w[0] * region_.texcoords[tri[0]] + best_w[1] * region_.texcoords[tri[1]] +
          best_w[2] * region_.texcoords[tri[2]];
@@ -105,21 +117,27 @@ AdaptiveSamplingResult adaptive_sampling(const ParticleGrid& input, const Region
   // Flat connectivity: neighbours, faces, faces around each vertex.
   Csr nbr, faces, vertex_faces;
   for (int p = 0; p < np; ++p) {
-    for (const auto v : mesh.vv_range(GridMesh::VertexHandle(p))) nbr.items.push_back(v.idx());
+    for (const auto v : mesh.vv_range(GridMesh::VertexHandle(p))) {
+      nbr.items.push_back(v.idx());
+    }
     nbr.start.push_back(static_cast<int>(nbr.items.size()));
-    for (const auto f : mesh.vf_range(GridMesh::VertexHandle(p)))
+    for (const auto f : mesh.vf_range(GridMesh::VertexHandle(p))) {
       vertex_faces.items.push_back(f.idx());
+    }
     vertex_faces.start.push_back(static_cast<int>(vertex_faces.items.size()));
   }
   for (const auto f : mesh.faces()) {
-    for (const auto v : mesh.fv_range(f)) faces.items.push_back(v.idx());
+    for (const auto v : mesh.fv_range(f)) {
+      faces.items.push_back(v.idx());
+    }
     faces.start.push_back(static_cast<int>(faces.items.size()));
   }
 
   // Boundary bookkeeping: position of each boundary particle in the loop, and its parameter s.
   std::vector<int> loop_index(np, -1);
-  for (size_t k = 0; k < grid.boundary_loop.size(); ++k)
+  for (size_t k = 0; k < grid.boundary_loop.size(); ++k) {
     loop_index[grid.boundary_loop[k]] = static_cast<int>(k);
+  }
   for (int p = 0; p < np; ++p) {
     if (grid.is_boundary[p] && loop_index[p] < 0) {
       throw InvalidInputError(
@@ -129,7 +147,9 @@ AdaptiveSamplingResult adaptive_sampling(const ParticleGrid& input, const Region
   const int nb = static_cast<int>(grid.boundary_loop.size());
   std::vector<double> s = grid.boundary_parameter;
   std::unique_ptr<BoundarySampler> sampler;
-  if (nb > 0 && options.move_boundary) sampler = std::make_unique<BoundarySampler>(region, name);
+  if (nb > 0 && options.move_boundary) {
+    sampler = std::make_unique<BoundarySampler>(region, name);
+  }
 
   std::vector<Eigen::Vector3d> x(np);
   for (int p = 0; p < np; ++p) {
@@ -200,11 +220,15 @@ AdaptiveSamplingResult adaptive_sampling(const ParticleGrid& input, const Region
   auto accept_moves = [&]() {
     // Normals and weights at the candidate positions, in parallel; acceptance is sequential.
     tbb::parallel_for(0, np, [&](int p) {
-      if (moving[p]) weight_at(new_sp[p], new_normal[p], new_r[p]);
+      if (moving[p]) {
+        weight_at(new_sp[p], new_normal[p], new_r[p]);
+      }
     });
     double largest = 0.0;
     for (int p = 0; p < np; ++p) {
-      if (!moving[p]) continue;
+      if (!moving[p]) {
+        continue;
+      }
       const double before = min_sine_around(p);
       const Eigen::Vector3d old_x = x[p], old_n = normal[p];
       const double old_r = r[p];
@@ -230,7 +254,9 @@ AdaptiveSamplingResult adaptive_sampling(const ParticleGrid& input, const Region
         ++rejected;
         continue;
       }
-      if (grid.is_boundary[p]) s[loop_index[p]] = new_s[p];
+      if (grid.is_boundary[p]) {
+        s[loop_index[p]] = new_s[p];
+      }
       largest = std::max(largest, (x[p] - old_x).norm());
     }
     return largest;
@@ -239,13 +265,17 @@ AdaptiveSamplingResult adaptive_sampling(const ParticleGrid& input, const Region
   // Interior particles, for the batched magnet.
   std::vector<int> interior;
   for (int p = 0; p < np; ++p) {
-    if (!grid.is_boundary[p]) interior.push_back(p);
+    if (!grid.is_boundary[p]) {
+      interior.push_back(p);
+    }
   }
   std::vector<Eigen::Vector3d> targets(interior.size());
   std::vector<SurfacePoint> hints(interior.size());
   std::vector<ClosestPoint> projected(interior.size());
   auto project_interior = [&] {
-    for (size_t k = 0; k < interior.size(); ++k) hints[k] = sp[interior[k]];
+    for (size_t k = 0; k < interior.size(); ++k) {
+      hints[k] = sp[interior[k]];
+    }
     projector.closest(targets, projected, hints);
     for (size_t k = 0; k < interior.size(); ++k) {
       new_x[interior[k]] = projected[k].position;
@@ -254,7 +284,9 @@ AdaptiveSamplingResult adaptive_sampling(const ParticleGrid& input, const Region
   };
 
   double spacing = mean_spring_length();
-  if (!(spacing > 0.0)) throw InvalidInputError(name, "the particle grid has no springs");
+  if (!(spacing > 0.0)) {
+    throw InvalidInputError(name, "the particle grid has no springs");
+  }
 
   // Optional seeded jitter: a random tangent displacement of every interior particle.
   if (options.jitter > 0.0 && !interior.empty()) {
@@ -278,7 +310,9 @@ AdaptiveSamplingResult adaptive_sampling(const ParticleGrid& input, const Region
   // fixed while the particles migrate (a mean over the moving particles would grow as they gather
   // in curved parts and drain the flat parts further).
   double rbar = 0.0;
-  for (int p = 0; p < np; ++p) rbar += r[p];
+  for (int p = 0; p < np; ++p) {
+    rbar += r[p];
+  }
   rbar /= np;
   const double cap = options.max_weight > 0.0 ? options.max_weight * rbar : 0.0;
 
@@ -347,7 +381,9 @@ AdaptiveSamplingResult adaptive_sampling(const ParticleGrid& input, const Region
       result.cancelled = true;
       break;
     }
-    if (result.converged) break;
+    if (result.converged) {
+      break;
+    }
   }
 
   // Write back: positions, boundary parameters, UVs, springs.
@@ -357,11 +393,15 @@ AdaptiveSamplingResult adaptive_sampling(const ParticleGrid& input, const Region
   grid.boundary_parameter = s;
   if (!grid.source_uv.empty()) {
     const RegionTexcoords texcoords(region);
-    for (int p = 0; p < np; ++p) texcoords.at(sp[p], grid.source_uv[p]);
+    for (int p = 0; p < np; ++p) {
+      texcoords.at(sp[p], grid.source_uv[p]);
+    }
   }
   grid.build_springs();
   double rbar_end = 0.0;
-  for (int p = 0; p < np; ++p) rbar_end += r[p];
+  for (int p = 0; p < np; ++p) {
+    rbar_end += r[p];
+  }
   result.mean_curvature_weight = np > 0 ? rbar_end / np : 0.0;
   result.rejected_moves = rejected;
   return result;

@@ -73,7 +73,9 @@ AnnulusTriangulation triangulate_annulus(const std::vector<Eigen::Vector2d>& poi
   }
 
   // Nesting levels by breadth-first flooding: crossing a constrained edge adds one level.
-  for (auto f = cdt.all_faces_begin(); f != cdt.all_faces_end(); ++f) f->info() = -1;
+  for (auto f = cdt.all_faces_begin(); f != cdt.all_faces_end(); ++f) {
+    f->info() = -1;
+  }
   std::deque<Cdt::Face_handle> border{cdt.infinite_face()};
   cdt.infinite_face()->info() = 0;
   for (int level = 0; !border.empty(); ++level) {
@@ -84,7 +86,9 @@ AnnulusTriangulation triangulate_annulus(const std::vector<Eigen::Vector2d>& poi
       queue.pop_front();
       for (int e = 0; e < 3; ++e) {
         const Cdt::Face_handle n = f->neighbor(e);
-        if (n->info() != -1) continue;
+        if (n->info() != -1) {
+          continue;
+        }
         if (cdt.is_constrained(Cdt::Edge(f, e))) {
           border.push_back(n);
         } else {
@@ -94,13 +98,17 @@ AnnulusTriangulation triangulate_annulus(const std::vector<Eigen::Vector2d>& poi
       }
     }
     for (const Cdt::Face_handle& f : border) {
-      if (f->info() == -1) f->info() = level + 1;
+      if (f->info() == -1) {
+        f->info() = level + 1;
+      }
     }
   }
 
   AnnulusTriangulation result;
   for (auto f = cdt.finite_faces_begin(); f != cdt.finite_faces_end(); ++f) {
-    if (f->info() != 1) continue;
+    if (f->info() != 1) {
+      continue;
+    }
     // CGAL stores finite faces counter-clockwise.
     result.triangles.emplace_back(f->vertex(0)->info(), f->vertex(1)->info(), f->vertex(2)->info());
   }

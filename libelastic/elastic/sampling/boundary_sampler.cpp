@@ -40,7 +40,9 @@ BoundarySampler::BoundarySampler(const Region& region, const std::string& name)
 BoundarySampler::Sample BoundarySampler::at(double s) const {
   Sample out;
   out.s = s - std::floor(s);
-  if (out.s >= 1.0) out.s = 0.0;
+  if (out.s >= 1.0) {
+    out.s = 0.0;
+  }
   const SurfaceCurve::Location loc = curve_.locate(out.s, cumulative_, length_);
   const int n = curve_.size();
   out.segment = loc.segment;
@@ -49,7 +51,9 @@ BoundarySampler::Sample BoundarySampler::at(double s) const {
   const Eigen::Vector3d chord =
       curve_.positions[(loc.segment + 1) % n] - curve_.positions[loc.segment];
   const double chord_length = chord.norm();
-  if (chord_length > 0.0) out.tangent = chord / chord_length;
+  if (chord_length > 0.0) {
+    out.tangent = chord / chord_length;
+  }
   const Eigen::Vector3i& owner = chord_triangle_[loc.segment];
   out.triangle = owner[0];
   out.barycentric.setZero();

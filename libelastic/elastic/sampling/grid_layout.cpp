@@ -49,7 +49,9 @@ ScaledFlattening scaled_flattening(const Region& region, const GridLayoutOptions
     boundary_area += cross2(out.uv[region.boundary[k]], out.uv[region.boundary[(k + 1) % nb]]);
   }
   if (boundary_area < 0.0) {
-    for (Eigen::Vector2d& p : out.uv) p.x() = -p.x();
+    for (Eigen::Vector2d& p : out.uv) {
+      p.x() = -p.x();
+    }
   }
   double area2 = 0.0;
   Eigen::Vector2d centroid = Eigen::Vector2d::Zero();
@@ -60,13 +62,16 @@ ScaledFlattening scaled_flattening(const Region& region, const GridLayoutOptions
     centroid += area * (a + b + c) / 3.0;
   }
   const double area3 = region.area();
-  if (!(area2 > 0.0) || !(area3 > 0.0))
+  if (!(area2 > 0.0) || !(area3 > 0.0)) {
     throw InvalidInputError(options.name, "the region has zero area");
+  }
   centroid /= area2;
   // Uniform scale so that planar area = surface area: lattice steps then approximate surface
   // lengths on average over the region.
   const double scale = std::sqrt(area3 / area2);
-  for (Eigen::Vector2d& p : out.uv) p = scale * (p - centroid);
+  for (Eigen::Vector2d& p : out.uv) {
+    p = scale * (p - centroid);
+  }
   return out;
 }
 
@@ -95,7 +100,9 @@ bool keep_largest_component(Lattice& L) {
   std::vector<int> label(L.cells.size(), -1);
   int best_label = -1, best_size = 0, labels = 0;
   for (int start = 0; start < static_cast<int>(L.cells.size()); ++start) {
-    if (!L.cells[start] || label[start] >= 0) continue;
+    if (!L.cells[start] || label[start] >= 0) {
+      continue;
+    }
     int size = 0;
     std::deque<int> queue{start};
     label[start] = labels;
@@ -106,7 +113,9 @@ bool keep_largest_component(Lattice& L) {
       const int a = c % cx, b = c / cx;
       const int nbr[4][2] = {{a - 1, b}, {a + 1, b}, {a, b - 1}, {a, b + 1}};
       for (const auto& n : nbr) {
-        if (!L.cell(n[0], n[1])) continue;
+        if (!L.cell(n[0], n[1])) {
+          continue;
+        }
         const int id = n[1] * cx + n[0];
         if (label[id] < 0) {
           label[id] = labels;
@@ -152,7 +161,9 @@ void fill_holes(Lattice& L) {
     const int a = c % cx, b = c / cx;
     const int nbr[4][2] = {{a - 1, b}, {a + 1, b}, {a, b - 1}, {a, b + 1}};
     for (const auto& n : nbr) {
-      if (n[0] < 0 || n[1] < 0 || n[0] >= cx || n[1] >= cy) continue;
+      if (n[0] < 0 || n[1] < 0 || n[0] >= cx || n[1] >= cy) {
+        continue;
+      }
       const int id = n[1] * cx + n[0];
       if (!L.cells[id] && !outside[id]) {
         outside[id] = 1;
@@ -161,7 +172,9 @@ void fill_holes(Lattice& L) {
     }
   }
   for (size_t c = 0; c < L.cells.size(); ++c) {
-    if (!L.cells[c] && !outside[c]) L.cells[c] = 1;
+    if (!L.cells[c] && !outside[c]) {
+      L.cells[c] = 1;
+    }
   }
 }
 
@@ -202,7 +215,9 @@ int count_used_points(const Lattice& L) {
   int n = 0;
   for (int j = 0; j < L.ny; ++j) {
     for (int i = 0; i < L.nx; ++i) {
-      if (L.cell(i - 1, j - 1) || L.cell(i, j - 1) || L.cell(i - 1, j) || L.cell(i, j)) ++n;
+      if (L.cell(i - 1, j - 1) || L.cell(i, j - 1) || L.cell(i - 1, j) || L.cell(i, j)) {
+        ++n;
+      }
     }
   }
   return n;
@@ -250,14 +265,17 @@ Lattice build_lattice(const Region& region, const ScaledFlattening& flat,
     for (int k = 0; k < m; ++k) {
       const Eigen::Vector2d& p = L.boundary2d[k];
       const Eigen::Vector2d& q = L.boundary2d[(k + 1) % m];
-      if ((p.y() <= y) != (q.y() <= y))
+      if ((p.y() <= y) != (q.y() <= y)) {
         xs.push_back(p.x() + (y - p.y()) / (q.y() - p.y()) * (q.x() - p.x()));
+      }
     }
     std::sort(xs.begin(), xs.end());
     size_t left = 0;
     for (int i = 0; i < L.nx; ++i) {
       const double x = L.point(i, j).x();
-      while (left < xs.size() && xs[left] < x) ++left;
+      while (left < xs.size() && xs[left] < x) {
+        ++left;
+      }
       keep[static_cast<size_t>(j) * L.nx + i] = (left % 2 == 1) ? 1 : 0;
     }
   }
@@ -279,10 +297,14 @@ Lattice build_lattice(const Region& region, const ScaledFlattening& flat,
     for (int j = ja; j <= jb; ++j) {
       for (int i = ia; i <= ib; ++i) {
         char& flag = keep[static_cast<size_t>(j) * L.nx + i];
-        if (!flag) continue;
+        if (!flag) {
+          continue;
+        }
         const Eigen::Vector2d x = L.point(i, j);
         const double t = len2 > 0.0 ? std::clamp((x - p).dot(pq) / len2, 0.0, 1.0) : 0.0;
-        if ((x - (p + t * pq)).squaredNorm() < clear * clear) flag = 0;
+        if ((x - (p + t * pq)).squaredNorm() < clear * clear) {
+          flag = 0;
+        }
       }
     }
   }
@@ -300,7 +322,9 @@ Lattice build_lattice(const Region& region, const ScaledFlattening& flat,
   for (int guard = 0; guard < 1000; ++guard) {
     const bool pinched = remove_pinches(L);
     const bool split = keep_largest_component(L);
-    if (!pinched && !split) break;
+    if (!pinched && !split) {
+      break;
+    }
   }
   L.interior = count_used_points(L);
   return L;
@@ -357,21 +381,27 @@ GridLayoutResult layout_particle_grid(const Region& region, const GridLayoutOpti
       } else if (!usable && best.nx == 0 && best_error == std::numeric_limits<double>::infinity()) {
         best = std::move(L);  // keep something to report on
       }
-      if (usable && error <= options.count_tolerance) break;
+      if (usable && error <= options.count_tolerance) {
+        break;
+      }
       if (count > n) {
         h_small = std::max(h_small, h);
       } else {
         h_big = std::min(h_big, h);
       }
       if (h_small > 0.0 && std::isfinite(h_big)) {
-        if (h_big / h_small < 1.0 + 1e-9) break;
+        if (h_big / h_small < 1.0 + 1e-9) {
+          break;
+        }
         h = std::sqrt(h_small * h_big);
       } else {
         // count ~ 1/h^2: rescale, within a factor of 2 per step.
         h *= std::clamp(std::sqrt(std::max(count, 1.0) / n), 0.5, 2.0);
       }
     }
-    if (best_error <= options.count_tolerance) break;
+    if (best_error <= options.count_tolerance) {
+      break;
+    }
   }
   if (!std::isfinite(best_error)) {
     throw InvalidInputError(options.name, "region too small or too thin for " +
@@ -395,7 +425,9 @@ GridLayoutResult layout_particle_grid(const Region& region, const GridLayoutOpti
     for (int i = 0; i < L.nx; ++i) {
       const int around = int(L.cell(i - 1, j - 1)) + int(L.cell(i, j - 1)) + int(L.cell(i - 1, j)) +
                          int(L.cell(i, j));
-      if (around == 0) continue;
+      if (around == 0) {
+        continue;
+      }
       point_id[static_cast<size_t>(j) * L.nx + i] = static_cast<int>(flat_positions.size());
       flat_positions.push_back(L.point(i, j));
       regular.push_back(around == 4 ? 1 : 0);
@@ -416,11 +448,15 @@ GridLayoutResult layout_particle_grid(const Region& region, const GridLayoutOpti
   std::vector<Eigen::Vector4i> quads;
   for (int b = 0; b + 1 < L.ny; ++b) {
     for (int a = 0; a + 1 < L.nx; ++a) {
-      if (!L.cell(a, b)) continue;
+      if (!L.cell(a, b)) {
+        continue;
+      }
       const int v00 = id(a, b), v10 = id(a + 1, b), v11 = id(a + 1, b + 1), v01 = id(a, b + 1);
       quads.emplace_back(v00, v10, v11, v01);
       const auto edge = [&](bool open, int from, int to) {
-        if (!open) return;
+        if (!open) {
+          return;
+        }
         next_on_outline[from] = to;
         first_outline = std::min(first_outline, from);
       };
@@ -434,7 +470,9 @@ GridLayoutResult layout_particle_grid(const Region& region, const GridLayoutOpti
   for (int v = first_outline;;) {
     outline.push_back(v);
     v = next_on_outline.at(v);
-    if (v == first_outline) break;
+    if (v == first_outline) {
+      break;
+    }
     if (outline.size() > next_on_outline.size()) {
       throw NumericalError(options.name, "grid layout: the quad outline is not one simple loop");
     }
@@ -443,7 +481,9 @@ GridLayoutResult layout_particle_grid(const Region& region, const GridLayoutOpti
     throw NumericalError(options.name, "grid layout: the quad outline is not one simple loop");
   }
   std::vector<int> boundary_ids(m);
-  for (int k = 0; k < m; ++k) boundary_ids[k] = interior + k;
+  for (int k = 0; k < m; ++k) {
+    boundary_ids[k] = interior + k;
+  }
   const AnnulusTriangulation band = triangulate_annulus(
       flat_positions, boundary_ids, outline, AnnulusTriangulationOptions{.name = options.name});
 
@@ -454,12 +494,15 @@ GridLayoutResult layout_particle_grid(const Region& region, const GridLayoutOpti
   grid.source_points.resize(total);
   std::vector<Eigen::Vector3d> positions(total);
   const bool with_uv = !region.texcoords.empty();
-  if (with_uv) grid.source_uv.resize(total);
+  if (with_uv) {
+    grid.source_uv.resize(total);
+  }
   const TriangleLocator2D locator(flat.uv, region.triangles);
   tbb::parallel_for(0, interior, [&](int p) {
     TriangleLocator2D::Hit hit = locator.locate(flat_positions[p], 1e-9);
-    if (!hit.found())
+    if (!hit.found()) {
       hit = locator.nearest(flat_positions[p]);  // round-off at the region's edge only
+    }
     const Eigen::Vector3d& w = hit.barycentric;
     grid.source_points[p] = region.point_in_triangle(hit.triangle, w[1], w[2]);
     positions[p] = region.surface->position(grid.source_points[p]);

@@ -13,14 +13,19 @@ SamplingStatistics measure_sampling(const ParticleGrid& grid, const LimitSurface
   const GridMesh& mesh = grid.mesh;
   const int np = grid.num_particles();
   st.particles = np;
-  for (int p = 0; p < np; ++p)
+  for (int p = 0; p < np; ++p) {
     (grid.is_boundary[p] ? st.boundary_particles : st.interior_particles)++;
+  }
   st.normal_springs = static_cast<int>(mesh.n_edges());
   for (const auto f : mesh.faces()) {
     const int n = static_cast<int>(mesh.valence(f));
     st.angular_springs += n;
-    if (n == 4) ++st.quads;
-    if (n == 3) ++st.triangles;
+    if (n == 4) {
+      ++st.quads;
+    }
+    if (n == 3) {
+      ++st.triangles;
+    }
   }
   const Eigen::Matrix3Xd x = grid.source_positions();
   std::vector<Eigen::Vector3d> normal(np);
@@ -50,7 +55,9 @@ SamplingStatistics measure_sampling(const ParticleGrid& grid, const LimitSurface
   // Density ratio between the high- and low-curvature quarters of the interior particles.
   std::vector<int> interior;
   for (int p = 0; p < np; ++p) {
-    if (!grid.is_boundary[p] && spacing[p] > 0.0) interior.push_back(p);
+    if (!grid.is_boundary[p] && spacing[p] > 0.0) {
+      interior.push_back(p);
+    }
   }
   if (interior.size() >= 8) {
     std::stable_sort(interior.begin(), interior.end(), [&](int a, int b) { return r[a] < r[b]; });
@@ -65,7 +72,9 @@ SamplingStatistics measure_sampling(const ParticleGrid& grid, const LimitSurface
   }
   for (const auto f : mesh.faces()) {
     std::vector<int> v;
-    for (const auto vh : mesh.fv_range(f)) v.push_back(vh.idx());
+    for (const auto vh : mesh.fv_range(f)) {
+      v.push_back(vh.idx());
+    }
     const int n = static_cast<int>(v.size());
     bool inverted = false;
     for (int c = 0; c < n; ++c) {
@@ -74,9 +83,13 @@ SamplingStatistics measure_sampling(const ParticleGrid& grid, const LimitSurface
       const double scale = e1.norm() * e2.norm();
       const double sine = scale > 0.0 ? e1.cross(e2).dot(normal[v[c]]) / scale : 0.0;
       st.min_corner_sine = std::min(st.min_corner_sine, sine);
-      if (sine <= 0.0) inverted = true;
+      if (sine <= 0.0) {
+        inverted = true;
+      }
     }
-    if (inverted) ++st.inverted_faces;
+    if (inverted) {
+      ++st.inverted_faces;
+    }
   }
   return st;
 }

@@ -43,8 +43,12 @@ void check_options(const ShapeOptions& options) {
 }
 
 void apply_scale(PolygonMesh& mesh, double scale) {
-  if (scale == 1.0) return;
-  for (Eigen::Vector3d& p : mesh.positions) p *= scale;
+  if (scale == 1.0) {
+    return;
+  }
+  for (Eigen::Vector3d& p : mesh.positions) {
+    p *= scale;
+  }
 }
 
 void reverse_faces(PolygonMesh& mesh) {
@@ -85,11 +89,17 @@ class HermiteProfile {
     tangents_.resize(n);
     for (size_t i = 0; i < n; ++i) {
       Eigen::Vector2d d = Eigen::Vector2d::Zero();
-      if (i > 0) d += (points_[i] - points_[i - 1]).normalized();
-      if (i + 1 < n) d += (points_[i + 1] - points_[i]).normalized();
+      if (i > 0) {
+        d += (points_[i] - points_[i - 1]).normalized();
+      }
+      if (i + 1 < n) {
+        d += (points_[i + 1] - points_[i]).normalized();
+      }
       tangents_[i] = d.normalized();
     }
-    if (points_.front().x() == 0.0) tangents_.front() = Eigen::Vector2d(1.0, 0.0);
+    if (points_.front().x() == 0.0) {
+      tangents_.front() = Eigen::Vector2d(1.0, 0.0);
+    }
   }
 
   Eigen::Vector2d operator()(double t) const {
@@ -145,8 +155,12 @@ struct RingLayout {
 
   double t_at_arc_length(double arc) const {
     auto it = std::lower_bound(dense_s.begin(), dense_s.end(), arc);
-    if (it == dense_s.begin()) return dense_t.front();
-    if (it == dense_s.end()) return dense_t.back();
+    if (it == dense_s.begin()) {
+      return dense_t.front();
+    }
+    if (it == dense_s.end()) {
+      return dense_t.back();
+    }
     const size_t k = static_cast<size_t>(it - dense_s.begin());
     const double w = (arc - dense_s[k - 1]) / (dense_s[k] - dense_s[k - 1]);
     return dense_t[k - 1] + w * (dense_t[k] - dense_t[k - 1]);
@@ -165,7 +179,9 @@ RingLayout layout_rings(const Profile& profile, int n, double step_factor, int m
   RingLayout layout;
   layout.dense_t = std::move(dense_t);
   double max_radius = 0.0;
-  for (const Eigen::Vector2d& q : p) max_radius = std::max(max_radius, q.x());
+  for (const Eigen::Vector2d& q : p) {
+    max_radius = std::max(max_radius, q.x());
+  }
   layout.pole_radius = 0.5 * max_radius;
   const double thin_radius = 0.25 * max_radius;
   const double max_turn = std::min(0.25 * kPi, 4.0 * kTwoPi / n);
@@ -184,7 +200,9 @@ RingLayout layout_rings(const Profile& profile, int n, double step_factor, int m
   for (size_t k = 0; k < count; ++k) {
     // Neighbours of sample k; at the ends of an open profile use the nearest interior sample's.
     size_t mid = k;
-    if (!profile.closed) mid = std::clamp<size_t>(k, 1, count - 2);
+    if (!profile.closed) {
+      mid = std::clamp<size_t>(k, 1, count - 2);
+    }
     const size_t prev = mid == 0 ? count - 2 : mid - 1;  // closed: p[count - 1] == p[0]
     const size_t next = mid + 1 == count ? 1 : mid + 1;
     const Eigen::Vector2d a = p[mid] - p[prev];
@@ -192,7 +210,9 @@ RingLayout layout_rings(const Profile& profile, int n, double step_factor, int m
     const double turn = std::atan2(std::abs(a.x() * b.y() - a.y() * b.x()), a.dot(b));
     const double curvature = turn / (0.5 * (a.norm() + b.norm()));
     double length = std::max(p[k].x(), k < pole_region_samples ? layout.pole_radius : thin_radius);
-    if (curvature > 0.0) length = std::min(length, max_turn / (angular_step * curvature));
+    if (curvature > 0.0) {
+      length = std::min(length, max_turn / (angular_step * curvature));
+    }
     step[k] = step_factor * angular_step * length;
   }
 
@@ -203,18 +223,24 @@ RingLayout layout_rings(const Profile& profile, int n, double step_factor, int m
     layout.dense_s[k] = layout.dense_s[k - 1] + ds;
     tau[k] = tau[k - 1] + ds / (0.5 * (step[k] + step[k - 1]));
   }
-  if (pole_region_samples > 0) layout.pole_region_end = layout.dense_s[pole_region_samples - 1];
+  if (pole_region_samples > 0) {
+    layout.pole_region_end = layout.dense_s[pole_region_samples - 1];
+  }
 
   const double total = tau[count - 1];
   int m = std::max(min_rings, static_cast<int>(std::lround(total)));
-  if (even_count && m % 2 != 0) ++m;
+  if (even_count && m % 2 != 0) {
+    ++m;
+  }
   const int rings = profile.closed ? m : m + 1;
   layout.t.resize(static_cast<size_t>(rings));
   layout.s.resize(static_cast<size_t>(rings));
   size_t k = 1;
   for (int i = 0; i < rings; ++i) {
     const double target = total * i / m;
-    while (k + 1 < count && tau[k] < target) ++k;
+    while (k + 1 < count && tau[k] < target) {
+      ++k;
+    }
     const double w = std::clamp((target - tau[k - 1]) / (tau[k] - tau[k - 1]), 0.0, 1.0);
     layout.t[i] = layout.dense_t[k - 1] + w * (layout.dense_t[k] - layout.dense_t[k - 1]);
     layout.s[i] = layout.dense_s[k - 1] + w * (layout.dense_s[k] - layout.dense_s[k - 1]);
@@ -271,7 +297,9 @@ double min_angle(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen
 // angle, then b).
 void stitch_triangles(PolygonMesh& mesh, const Ring& a, const Ring& b) {
   if (a.count == 1) {  // fan around a pole
-    for (int j = 0; j < b.count; ++j) mesh.add_face({a.first, b.vertex(j + 1), b.vertex(j)});
+    for (int j = 0; j < b.count; ++j) {
+      mesh.add_face({a.first, b.vertex(j + 1), b.vertex(j)});
+    }
     return;
   }
   const double da = kTwoPi / a.count;
@@ -373,10 +401,16 @@ void add_quad_disk(PolygonMesh& mesh, const Profile& profile, const RingLayout& 
   auto perimeter = [&](double x, double y) {  // (x, y) on the boundary of [0,a] x [0,b], grid units
     const double u = 2.0 * x / a - 1.0;
     const double v = 2.0 * y / b - 1.0;
-    if (-v >= std::abs(u)) return x;               // bottom side, y = 0
-    if (u >= std::abs(v)) return a + y;            // right side, x = a
-    if (v >= std::abs(u)) return a + b + (a - x);  // top side, y = b
-    return 2.0 * a + b + (b - y);                  // left side, x = 0
+    if (-v >= std::abs(u)) {
+      return x;  // bottom side, y = 0
+    }
+    if (u >= std::abs(v)) {
+      return a + y;  // right side, x = a
+    }
+    if (v >= std::abs(u)) {
+      return a + b + (a - x);  // top side, y = b
+    }
+    return 2.0 * a + b + (b - y);  // left side, x = 0
   };
   std::vector<int> index(static_cast<size_t>((a + 1) * (b + 1)));
   auto id = [&](int i, int j) -> int& { return index[static_cast<size_t>(j * (a + 1) + i)]; };
@@ -404,8 +438,9 @@ void add_quad_disk(PolygonMesh& mesh, const Profile& profile, const RingLayout& 
   // (i,j), (i,j+1), (i+1,j+1), (i+1,j) runs clockwise in the (u, v) square, which the map sends
   // orientation-preservingly to increasing angle: the default convention for a pole at the start.
   for (int j = 0; j < b; ++j) {
-    for (int i = 0; i < a; ++i)
+    for (int i = 0; i < a; ++i) {
       mesh.add_face({id(i, j), id(i, j + 1), id(i + 1, j + 1), id(i + 1, j)});
+    }
   }
 }
 
@@ -430,11 +465,15 @@ PolygonMesh sweep(const Profile& profile, const ShapeOptions& options) {
     const Eigen::Vector2d rz = profile.at(layout.t[i]);
     if (i == 0 && profile.pole_at_start) {
       rings[0] = {mesh.num_vertices(), 1, 0.0};
-      if (tris) mesh.positions.push_back({0.0, 0.0, rz.y()});
+      if (tris) {
+        mesh.positions.push_back({0.0, 0.0, rz.y()});
+      }
       continue;
     }
     if (!tris) {
-      if (i >= disk_ring) rings[i] = add_ring(mesh, rz, n, 0.0);
+      if (i >= disk_ring) {
+        rings[i] = add_ring(mesh, rz, n, 0.0);
+      }
       continue;
     }
     // Triangles: in the pole region the rings have fewer vertices (about n r / pole_radius, so that
@@ -464,11 +503,15 @@ PolygonMesh sweep(const Profile& profile, const ShapeOptions& options) {
     } else {
       std::vector<int> polygon(
           static_cast<size_t>(n));  // decreasing angle: normal -z at a start pole
-      for (int j = 0; j < n; ++j) polygon[j] = rim.vertex(n - 1 - j);
+      for (int j = 0; j < n; ++j) {
+        polygon[j] = rim.vertex(n - 1 - j);
+      }
       mesh.add_face(polygon);
     }
   }
-  if (profile.flip) reverse_faces(mesh);
+  if (profile.flip) {
+    reverse_faces(mesh);
+  }
   apply_scale(mesh, options.scale);
   return mesh;
 }
@@ -543,17 +586,23 @@ PolygonMesh icosphere(int k) {
   for (size_t i = 0; i < 12; ++i) {
     for (size_t j = i + 1; j < 12; ++j) {
       for (size_t l = j + 1; l < 12; ++l) {
-        if (!adjacent(i, j) || !adjacent(j, l) || !adjacent(i, l)) continue;
+        if (!adjacent(i, j) || !adjacent(j, l) || !adjacent(i, l)) {
+          continue;
+        }
         std::array<int, 3> f{static_cast<int>(i), static_cast<int>(j), static_cast<int>(l)};
         const Eigen::Vector3d normal = (corners[j] - corners[i]).cross(corners[l] - corners[i]);
-        if (normal.dot(corners[i] + corners[j] + corners[l]) < 0.0) std::swap(f[1], f[2]);
+        if (normal.dot(corners[i] + corners[j] + corners[l]) < 0.0) {
+          std::swap(f[1], f[2]);
+        }
         faces.push_back(f);
       }
     }
   }
 
   PolygonMesh mesh;
-  for (const Eigen::Vector3d& c : corners) mesh.positions.push_back(c.normalized());
+  for (const Eigen::Vector3d& c : corners) {
+    mesh.positions.push_back(c.normalized());
+  }
   // Interior vertices of each edge, ordered from its lower to its higher corner index.
   std::unordered_map<int, int> edge_first;              // key lo * 12 + hi
   auto edge_vertex = [&](int u, int w, int weight_w) {  // point (k - weight_w) u + weight_w w
@@ -575,14 +624,28 @@ PolygonMesh icosphere(int k) {
     std::vector<int> grid(static_cast<size_t>((k + 1) * (k + 1)), -1);
     auto point = [&](int i, int j) -> int {
       int& slot = grid[static_cast<size_t>(i * (k + 1) + j)];
-      if (slot >= 0) return slot;
+      if (slot >= 0) {
+        return slot;
+      }
       const int wa = k - i - j;
-      if (i == 0 && j == 0) return slot = A;
-      if (wa == 0 && j == 0) return slot = B;
-      if (wa == 0 && i == 0) return slot = C;
-      if (j == 0) return slot = edge_vertex(A, B, i);
-      if (i == 0) return slot = edge_vertex(A, C, j);
-      if (wa == 0) return slot = edge_vertex(B, C, j);
+      if (i == 0 && j == 0) {
+        return slot = A;
+      }
+      if (wa == 0 && j == 0) {
+        return slot = B;
+      }
+      if (wa == 0 && i == 0) {
+        return slot = C;
+      }
+      if (j == 0) {
+        return slot = edge_vertex(A, B, i);
+      }
+      if (i == 0) {
+        return slot = edge_vertex(A, C, j);
+      }
+      if (wa == 0) {
+        return slot = edge_vertex(B, C, j);
+      }
       slot = mesh.num_vertices();
       mesh.positions.push_back((wa * corners[A] + i * corners[B] + j * corners[C]).normalized());
       return slot;
@@ -590,7 +653,9 @@ PolygonMesh icosphere(int k) {
     for (int i = 0; i < k; ++i) {
       for (int j = 0; i + j < k; ++j) {
         mesh.add_face({point(i, j), point(i + 1, j), point(i, j + 1)});
-        if (i + j + 2 <= k) mesh.add_face({point(i + 1, j), point(i + 1, j + 1), point(i, j + 1)});
+        if (i + j + 2 <= k) {
+          mesh.add_face({point(i + 1, j), point(i + 1, j + 1), point(i, j + 1)});
+        }
       }
     }
   }
@@ -608,15 +673,31 @@ const std::vector<std::string>& shape_names() {
 }
 
 PolygonMesh make_shape(std::string_view name, const ShapeOptions& options) {
-  if (name == "plane") return make_plane(options);
-  if (name == "cylinder") return make_cylinder(options);
-  if (name == "torus") return make_torus(options);
-  if (name == "vase") return make_vase(options);
-  if (name == "goblet") return make_goblet(options);
-  if (name == "cap") return make_cap(options);
-  if (name == "sphere") return make_sphere(options);
+  if (name == "plane") {
+    return make_plane(options);
+  }
+  if (name == "cylinder") {
+    return make_cylinder(options);
+  }
+  if (name == "torus") {
+    return make_torus(options);
+  }
+  if (name == "vase") {
+    return make_vase(options);
+  }
+  if (name == "goblet") {
+    return make_goblet(options);
+  }
+  if (name == "cap") {
+    return make_cap(options);
+  }
+  if (name == "sphere") {
+    return make_sphere(options);
+  }
   std::string known;
-  for (const std::string& n : shape_names()) known += (known.empty() ? "" : ", ") + n;
+  for (const std::string& n : shape_names()) {
+    known += (known.empty() ? "" : ", ") + n;
+  }
   throw InvalidInputError(std::string(name), "unknown shape (known: " + known + ")");
 }
 

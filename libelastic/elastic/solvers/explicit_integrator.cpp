@@ -25,8 +25,9 @@ RelaxationResult relax_explicit(const RelaxationProblem& problem,
   const ExplicitOptions& eo = options.explicit_integrator;
   if (!(eo.mass > 0.0) || !std::isfinite(eo.mass) || !valid_parameter(eo.damping) ||
       !valid_parameter(eo.time_step) || !valid_parameter(eo.magnet_stiffness) ||
-      !(eo.stability_factor > 0.0 && eo.stability_factor < 1.0) || !(eo.drift_tolerance > 0.0))
+      !(eo.stability_factor > 0.0 && eo.stability_factor < 1.0) || !(eo.drift_tolerance > 0.0)) {
     throw InvalidInputError("relaxation", "explicit integrator options out of range");
+  }
 
   RelaxationResult result;
   result.solver = SolverKind::Faithful;
@@ -55,15 +56,17 @@ RelaxationResult relax_explicit(const RelaxationProblem& problem,
   for (Eigen::Index col = 0; col < laplacian.outerSize(); ++col) {
     for (Eigen::SparseMatrix<double>::InnerIterator it(laplacian, col); it; ++it) {
       row_sums[it.row()] += std::abs(it.value());
-      if (it.row() == col)
+      if (it.row() == col) {
         max_diagonal = std::max(max_diagonal, it.value());
-      else
+      } else {
         row_sums[col] += std::abs(it.value());
+      }
     }
   }
   double max_row_sum = 0.0;
-  for (Eigen::Index k = 0; k < row_sums.size(); ++k)
+  for (Eigen::Index k = 0; k < row_sums.size(); ++k) {
     max_row_sum = std::max(max_row_sum, row_sums[k]);
+  }
   const double magnet = eo.magnet_stiffness > 0.0 ? eo.magnet_stiffness : max_diagonal;
   const double lambda_max = max_row_sum + magnet;
   const double mass = eo.mass;
@@ -74,7 +77,9 @@ RelaxationResult relax_explicit(const RelaxationProblem& problem,
     const solver_detail::LaplacianFactor factor(laplacian, interior_coordinates(setup));
     // Inverse iteration from the all-ones vector (the slowest Dirichlet mode has one sign).
     Eigen::VectorXd v = Eigen::VectorXd::Ones(laplacian.rows()).normalized();
-    for (int it = 0; it < 30; ++it) v = factor.solve(v).normalized();
+    for (int it = 0; it < 30; ++it) {
+      v = factor.solve(v).normalized();
+    }
     // Rayleigh quotient, |v| = 1.
     const double lambda_min = v.dot(laplacian.selfadjointView<Eigen::Lower>() * v);
     damping = 2.0 * std::sqrt(mass * 0.5 * lambda_min);
@@ -148,9 +153,12 @@ RelaxationResult relax_explicit(const RelaxationProblem& problem,
         break;
       }
     }
-    if (step >= max_steps) break;
-    if (options.frame && step % options.frame_interval == 0)
+    if (step >= max_steps) {
+      break;
+    }
+    if (options.frame && step % options.frame_interval == 0) {
       options.frame({step, &setup.positions, energies.total(), relative});
+    }
 
     // Eq. 9 with f_int = grad E (springs + magnet), then eqs. 10-12.
     setup.springs.evaluate(setup.positions, &gradient);

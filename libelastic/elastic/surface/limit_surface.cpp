@@ -105,7 +105,9 @@ Eigen::Vector2d clamp_to_domain(bool triangle, Eigen::Vector2d uv) {
   uv = uv.cwiseMax(0.0).cwiseMin(1.0);
   if (triangle) {
     const double s = uv.x() + uv.y();
-    if (s > 1.0) uv /= s;  // pull back onto the hypotenuse along the ray from the origin
+    if (s > 1.0) {
+      uv /= s;  // pull back onto the hypotenuse along the ray from the origin
+    }
   }
   return uv;
 }
@@ -128,7 +130,9 @@ struct PtexAdjacency {
     const int n = count[static_cast<size_t>(edge)];
     const auto& row = links[static_cast<size_t>(edge)];
     for (int i = 0; i + 1 < n; ++i) {
-      if (t <= row[static_cast<size_t>(i)].t_end) return row[static_cast<size_t>(i)];
+      if (t <= row[static_cast<size_t>(i)].t_end) {
+        return row[static_cast<size_t>(i)];
+      }
     }
     return row[static_cast<size_t>(n - 1)];
   }
@@ -258,7 +262,9 @@ void gregory_quad_basis(double s, double t, Jet w[20]) {
   static constexpr int kBoundary[12][3] = {{0, 0, 0},  {1, 1, 0},  {7, 2, 0},  {5, 3, 0},
                                            {2, 0, 1},  {6, 3, 1},  {16, 0, 2}, {12, 3, 2},
                                            {15, 0, 3}, {17, 1, 3}, {11, 2, 3}, {10, 3, 3}};
-  for (const auto& b : kBoundary) w[b[0]] = tensor(b[1], b[2]);
+  for (const auto& b : kBoundary) {
+    w[b[0]] = tensor(b[1], b[2]);
+  }
   const Jet g[4] = {rational(s, 1, 0, s + t, 1, 1, 0.0), rational(t, 0, 1, 1.0 - s + t, -1, 1, 0.0),
                     rational(1.0 - s, -1, 0, 2.0 - s - t, -1, -1, 0.0),
                     rational(1.0 - t, 0, -1, 1.0 + s - t, 1, -1, 0.0)};
@@ -375,7 +381,9 @@ struct LimitSurface::Impl {
       fail("surface point on ptex face " + std::to_string(p.face) + ", valid faces are 0.." +
            std::to_string(ptex_to_control.size() - 1));
     }
-    if (!std::isfinite(p.u) || !std::isfinite(p.v)) fail("surface point with non-finite (u, v)");
+    if (!std::isfinite(p.u) || !std::isfinite(p.v)) {
+      fail("surface point with non-finite (u, v)");
+    }
   }
 
   template <bool kDerivatives>
@@ -391,7 +399,9 @@ void LimitSurface::Impl::validate_topology(const LimitSurfaceOptions& options) {
   }
   const int nv = mesh.num_vertices();
   const int nf = mesh.num_faces();
-  if (nf == 0 || nv == 0) fail("the mesh is empty (no faces)");
+  if (nf == 0 || nv == 0) {
+    fail("the mesh is empty (no faces)");
+  }
   if (static_cast<int>(mesh.face_offsets.size()) != nf + 1 || mesh.face_offsets.front() != 0 ||
       mesh.face_offsets.back() != static_cast<int>(mesh.face_vertices.size())) {
     fail("inconsistent face offsets");
@@ -411,7 +421,9 @@ void LimitSurface::Impl::validate_topology(const LimitSurfaceOptions& options) {
   for (int f = 0; f < nf; ++f) {
     const auto fv = mesh.face(f);
     const int n = static_cast<int>(fv.size());
-    if (n < 3) fail("face " + std::to_string(f) + " has fewer than 3 corners");
+    if (n < 3) {
+      fail("face " + std::to_string(f) + " has fewer than 3 corners");
+    }
     for (int i = 0; i < n; ++i) {
       const int a = fv[static_cast<size_t>(i)];
       const int b = fv[static_cast<size_t>((i + 1) % n)];
@@ -432,7 +444,9 @@ void LimitSurface::Impl::validate_topology(const LimitSurfaceOptions& options) {
             [](const Directed& x, const Directed& y) { return x.key < y.key; });
   for (size_t i = 0; i < edges.size();) {
     size_t j = i;
-    while (j < edges.size() && edges[j].key == edges[i].key) ++j;
+    while (j < edges.size() && edges[j].key == edges[i].key) {
+      ++j;
+    }
     const std::string edge_name =
         "edge (" + std::to_string(edges[i].a) + ", " + std::to_string(edges[i].b) + ")";
     if (j - i > 2) {
@@ -462,8 +476,9 @@ void LimitSurface::Impl::validate_topology(const LimitSurfaceOptions& options) {
       }
     }
     for (const auto& [v, sharpness] : mesh.corners) {
-      if (v < 0 || v >= nv)
+      if (v < 0 || v >= nv) {
         fail("corner tag on vertex " + std::to_string(v) + ", which does not exist");
+      }
       if (!std::isfinite(sharpness) || sharpness < 0.0) {
         fail("corner tag on vertex " + std::to_string(v) + " has an invalid sharpness");
       }
@@ -478,8 +493,9 @@ void LimitSurface::Impl::build_refiner(const LimitSurfaceOptions& options) {
       scheme = all_triangles ? SubdivisionScheme::Loop : SubdivisionScheme::CatmullClark;
       break;
     case SubdivisionScheme::Loop:
-      if (!all_triangles)
+      if (!all_triangles) {
         fail("the Loop scheme needs a triangle mesh, and this mesh has other faces");
+      }
       scheme = SubdivisionScheme::Loop;
       break;
     case SubdivisionScheme::CatmullClark:
@@ -489,8 +505,9 @@ void LimitSurface::Impl::build_refiner(const LimitSurfaceOptions& options) {
   triangle = scheme == SubdivisionScheme::Loop;
 
   std::vector<int> verts_per_face(static_cast<size_t>(mesh.num_faces()));
-  for (int f = 0; f < mesh.num_faces(); ++f)
+  for (int f = 0; f < mesh.num_faces(); ++f) {
     verts_per_face[static_cast<size_t>(f)] = mesh.face_size(f);
+  }
 
   std::vector<Far::Index> crease_pairs;
   std::vector<float> crease_weights;
@@ -555,7 +572,9 @@ void LimitSurface::Impl::build_patches(int isolation_level) {
 
   refiner->RefineAdaptive(patch_options.GetRefineAdaptiveOptions());
   patch_table.reset(Far::PatchTableFactory::Create(*refiner, patch_options));
-  if (!patch_table) fail("OpenSubdiv could not build the patch table");
+  if (!patch_table) {
+    fail("OpenSubdiv could not build the patch table");
+  }
 
   // Positions of every refined vertex (all levels), then the end caps' local points. Patch control
   // point indices address this concatenation.
@@ -576,7 +595,9 @@ void LimitSurface::Impl::build_patches(int isolation_level) {
   if (num_local > 0) {
     // PatchTable::ComputeLocalPointValues asserts on double-precision tables: use the stencils.
     const auto* stencils = patch_table->GetLocalPointStencilTable<double>();
-    if (!stencils) fail("OpenSubdiv built no local point stencils");
+    if (!stencils) {
+      fail("OpenSubdiv built no local point stencils");
+    }
     stencils->UpdateValues(points.data(), points.data() + num_refined);
   }
   auto vec = [&](Far::Index i) {
@@ -639,12 +660,20 @@ void LimitSurface::Impl::build_patches(int isolation_level) {
         };
         const int boundary = param.GetBoundary();
         for (int j = 0; j < 4; ++j) {
-          if (boundary & 8) at(j, 0) = 2.0 * at(j, 1) - at(j, 2);
-          if (boundary & 2) at(j, 3) = 2.0 * at(j, 2) - at(j, 1);
+          if (boundary & 8) {
+            at(j, 0) = 2.0 * at(j, 1) - at(j, 2);
+          }
+          if (boundary & 2) {
+            at(j, 3) = 2.0 * at(j, 2) - at(j, 1);
+          }
         }
         for (int j = 0; j < 4; ++j) {
-          if (boundary & 1) at(0, j) = 2.0 * at(1, j) - at(2, j);
-          if (boundary & 4) at(3, j) = 2.0 * at(2, j) - at(1, j);
+          if (boundary & 1) {
+            at(0, j) = 2.0 * at(1, j) - at(2, j);
+          }
+          if (boundary & 4) {
+            at(3, j) = 2.0 * at(2, j) - at(1, j);
+          }
         }
         patch_points.insert(patch_points.end(), p.begin(), p.end());
       } else {
@@ -710,7 +739,9 @@ void LimitSurface::Impl::build_adjacency() {
                         fv[static_cast<size_t>(e)];
     const auto it = std::lower_bound(halves.begin(), halves.end(), key,
                                      [](const Half& h, int64_t k) { return h.key < k; });
-    if (it == halves.end() || it->key != key) return {-1, -1};
+    if (it == halves.end() || it->key != key) {
+      return {-1, -1};
+    }
     return {it->face, it->edge};
   };
 
@@ -768,7 +799,9 @@ void LimitSurface::Impl::build_adjacency() {
           // Their stretch covers tau' in [q.alpha, q.alpha + q.beta], i.e. tau = 1 - tau'.
           const double lo = std::max(p.alpha, 1.0 - q.alpha - q.beta);
           const double hi = std::min(p.alpha + p.beta, 1.0 - q.alpha);
-          if (hi - lo <= 1e-12) continue;
+          if (hi - lo <= 1e-12) {
+            continue;
+          }
           const double ta = (lo - p.alpha) / p.beta, tb = (hi - p.alpha) / p.beta;
           const double ua = (1.0 - lo - q.alpha) / q.beta, ub = (1.0 - hi - q.alpha) / q.beta;
           row[static_cast<size_t>(count++)] = make_link(p.edge, ta, tb, q.ptex, q.edge, ua, ub);
@@ -800,7 +833,9 @@ void LimitSurface::Impl::evaluate(const SurfacePoint& p, SurfaceDerivatives& out
   check_point(p);
   const Eigen::Vector2d uv = clamp_to_domain(triangle, p.uv());
   const Far::PatchTable::PatchHandle* handle = patch_map->FindPatch(p.face, uv.x(), uv.y());
-  if (!handle) throw NumericalError(name, "no patch at ptex face " + std::to_string(p.face));
+  if (!handle) {
+    throw NumericalError(name, "no patch at ptex face " + std::to_string(p.face));
+  }
   const PatchRecord& rec = patches[static_cast<size_t>(handle->patchIndex)];
   static_assert(sizeof(Eigen::Vector3d) == 3 * sizeof(double),
                 "control points are read as xyz triples");
@@ -927,7 +962,9 @@ LimitSurface::LimitSurface(const PolygonMesh& mesh, const LimitSurfaceOptions& o
   const Far::PtexIndices ptex(*m.refiner);
   const int nf = mesh.num_faces();
   m.control_to_ptex.resize(static_cast<size_t>(nf) + 1);
-  for (int f = 0; f < nf; ++f) m.control_to_ptex[static_cast<size_t>(f)] = ptex.GetFaceId(f);
+  for (int f = 0; f < nf; ++f) {
+    m.control_to_ptex[static_cast<size_t>(f)] = ptex.GetFaceId(f);
+  }
   m.control_to_ptex[static_cast<size_t>(nf)] = ptex.GetNumFaces();
   m.ptex_to_control.resize(static_cast<size_t>(ptex.GetNumFaces()));
   for (int f = 0; f < nf; ++f) {
@@ -942,7 +979,9 @@ LimitSurface::LimitSurface(const PolygonMesh& mesh, const LimitSurfaceOptions& o
     const auto fv = mesh.face(f);
     for (int c = 0; c < static_cast<int>(fv.size()); ++c) {
       auto& slot = m.vertex_face_corner[static_cast<size_t>(fv[static_cast<size_t>(c)])];
-      if (slot.first < 0) slot = {f, c};
+      if (slot.first < 0) {
+        slot = {f, c};
+      }
     }
   }
 
@@ -986,9 +1025,15 @@ const PolygonMesh& LimitSurface::control_mesh() const {
 }
 
 bool LimitSurface::in_domain(const SurfacePoint& p, double tolerance) const {
-  if (p.face < 0 || p.face >= num_faces()) return false;
-  if (!(p.u >= -tolerance && p.v >= -tolerance)) return false;  // also rejects NaN
-  if (impl_->triangle) return p.u + p.v <= 1.0 + tolerance;
+  if (p.face < 0 || p.face >= num_faces()) {
+    return false;
+  }
+  if (!(p.u >= -tolerance && p.v >= -tolerance)) {
+    return false;  // also rejects NaN
+  }
+  if (impl_->triangle) {
+    return p.u + p.v <= 1.0 + tolerance;
+  }
   return p.u <= 1.0 + tolerance && p.v <= 1.0 + tolerance;
 }
 
@@ -1016,7 +1061,9 @@ SurfaceCurvature LimitSurface::curvature(const SurfaceDerivatives& d) {
   if (!(a > 0.0) || !(area > 0.0) || !std::isfinite(area)) {
     // Degenerate parametrisation: no tangent plane from these derivatives. Report a flat point with
     // whatever direction is available (curvature(SurfacePoint) avoids this by nudging the point).
-    if (area > 0.0) out.normal = cross / area;
+    if (area > 0.0) {
+      out.normal = cross / area;
+    }
     out.dir1 = out.normal.unitOrthogonal();
     out.dir2 = out.normal.cross(out.dir1);
     return out;
@@ -1073,7 +1120,9 @@ SurfacePoint LimitSurface::walk(const SurfacePoint& from, const Eigen::Vector2d&
                                 int* crossed) const {
   const Impl& m = *impl_;
   m.check_point(from);
-  if (!delta.allFinite()) m.fail("walk with a non-finite step");
+  if (!delta.allFinite()) {
+    m.fail("walk with a non-finite step");
+  }
   const bool tri = m.triangle;
   int face = from.face;
   Eigen::Vector2d x = clamp_to_domain(tri, from.uv());
@@ -1091,14 +1140,24 @@ SurfacePoint LimitSurface::walk(const SurfacePoint& from, const Eigen::Vector2d&
         edge = k;
       }
     };
-    if (d.y() < 0.0) consider(-x.y() / d.y(), 0);            // v = 0
-    if (d.x() < 0.0) consider(-x.x() / d.x(), tri ? 2 : 3);  // u = 0
+    if (d.y() < 0.0) {
+      consider(-x.y() / d.y(), 0);  // v = 0
+    }
+    if (d.x() < 0.0) {
+      consider(-x.x() / d.x(), tri ? 2 : 3);  // u = 0
+    }
     if (tri) {
       const double g = d.x() + d.y();
-      if (g > 0.0) consider((1.0 - x.x() - x.y()) / g, 1);  // u + v = 1
+      if (g > 0.0) {
+        consider((1.0 - x.x() - x.y()) / g, 1);  // u + v = 1
+      }
     } else {
-      if (d.x() > 0.0) consider((1.0 - x.x()) / d.x(), 1);  // u = 1
-      if (d.y() > 0.0) consider((1.0 - x.y()) / d.y(), 2);  // v = 1
+      if (d.x() > 0.0) {
+        consider((1.0 - x.x()) / d.x(), 1);  // u = 1
+      }
+      if (d.y() > 0.0) {
+        consider((1.0 - x.y()) / d.y(), 2);  // v = 1
+      }
     }
     if (edge < 0 || s_exit >= 1.0) {
       x = clamp_to_domain(tri, x + d);
@@ -1118,12 +1177,16 @@ SurfacePoint LimitSurface::walk(const SurfacePoint& from, const Eigen::Vector2d&
     face = link.face;
     ++count;
   }
-  if (crossed) *crossed = count;
+  if (crossed) {
+    *crossed = count;
+  }
   return {face, x.x(), x.y()};
 }
 
 bool LimitSurface::on_boundary(const SurfacePoint& p, double tolerance) const {
-  if (!in_domain(p, tolerance)) return false;
+  if (!in_domain(p, tolerance)) {
+    return false;
+  }
   const Impl& m = *impl_;
   const bool tri = m.triangle;
   const Eigen::Vector2d x = p.uv();
@@ -1140,9 +1203,13 @@ bool LimitSurface::on_boundary(const SurfacePoint& p, double tolerance) const {
                  : k == 2 ? std::abs(1.0 - x.y())
                           : std::abs(x.x());
     }
-    if (distance > tolerance) continue;
+    if (distance > tolerance) {
+      continue;
+    }
     const double t = std::clamp(edge_parameter(tri, k, x), 0.0, 1.0);
-    if (m.adjacency[static_cast<size_t>(p.face)].find(k, t).face < 0) return true;
+    if (m.adjacency[static_cast<size_t>(p.face)].find(k, t).face < 0) {
+      return true;
+    }
   }
   return false;
 }
@@ -1153,7 +1220,9 @@ SurfacePoint LimitSurface::vertex_point(int control_vertex) const {
     m.fail("control vertex " + std::to_string(control_vertex) + " does not exist");
   }
   const auto [f, c] = m.vertex_face_corner[static_cast<size_t>(control_vertex)];
-  if (f < 0) m.fail("control vertex " + std::to_string(control_vertex) + " belongs to no face");
+  if (f < 0) {
+    m.fail("control vertex " + std::to_string(control_vertex) + " belongs to no face");
+  }
   const int first = m.control_to_ptex[static_cast<size_t>(f)];
   if (m.triangle || m.mesh.face_size(f) == 4) {
     const Eigen::Vector2d uv = corner_uv(m.triangle, c);
@@ -1166,7 +1235,9 @@ SurfacePoint LimitSurface::face_center(int ptex_face) const {
   if (ptex_face < 0 || ptex_face >= num_faces()) {
     impl_->fail("ptex face " + std::to_string(ptex_face) + " does not exist");
   }
-  if (impl_->triangle) return {ptex_face, 1.0 / 3.0, 1.0 / 3.0};
+  if (impl_->triangle) {
+    return {ptex_face, 1.0 / 3.0, 1.0 / 3.0};
+  }
   return {ptex_face, 0.5, 0.5};
 }
 

@@ -20,7 +20,9 @@ class EdgeIndex {
     for (int f = 0; f < mesh.num_faces(); ++f) {
       const auto fv = mesh.face(f);
       const size_t n = fv.size();
-      for (size_t i = 0; i < n; ++i) keys_.push_back(key(fv[i], fv[(i + 1) % n]));
+      for (size_t i = 0; i < n; ++i) {
+        keys_.push_back(key(fv[i], fv[(i + 1) % n]));
+      }
     }
     std::sort(keys_.begin(), keys_.end());
     keys_.erase(std::unique(keys_.begin(), keys_.end()), keys_.end());
@@ -78,7 +80,9 @@ LimitTessellation tessellate(const LimitSurface& surface, const TessellationOpti
     throw InvalidInputError(surface.name(), "tessellation resolution " + std::to_string(n) +
                                                 " is out of range 1..1024");
   }
-  if (need_even && n % 2 == 1) n = std::min(n + 1, 1024);
+  if (need_even && n % 2 == 1) {
+    n = std::min(n + 1, 1024);
+  }
 
   LimitTessellation out;
   out.resolution = n;
@@ -99,10 +103,14 @@ LimitTessellation tessellate(const LimitSurface& surface, const TessellationOpti
       static_cast<size_t>(spoke_offset.back()) * static_cast<size_t>(std::max(half - 1, 0)), -1);
 
   auto make = [&](int* slot, const SurfacePoint& p) {
-    if (slot && *slot >= 0) return *slot;
+    if (slot && *slot >= 0) {
+      return *slot;
+    }
     const int id = static_cast<int>(out.points.size());
     out.points.push_back(p);
-    if (slot) *slot = id;
+    if (slot) {
+      *slot = id;
+    }
     return id;
   };
   // Sample s of N along control edge e of face f (from corner e towards corner e+1).
@@ -110,8 +118,12 @@ LimitTessellation tessellate(const LimitSurface& surface, const TessellationOpti
     const auto fv = mesh.face(f);
     const size_t k = fv.size();
     const int a = fv[static_cast<size_t>(e) % k], b = fv[(static_cast<size_t>(e) + 1) % k];
-    if (s == 0) return &vertex_ids[static_cast<size_t>(a)];
-    if (s == n) return &vertex_ids[static_cast<size_t>(b)];
+    if (s == 0) {
+      return &vertex_ids[static_cast<size_t>(a)];
+    }
+    if (s == n) {
+      return &vertex_ids[static_cast<size_t>(b)];
+    }
     const int canonical = a < b ? s : n - s;
     return &edge_ids[static_cast<size_t>(edges.id(a, b)) * static_cast<size_t>(n - 1) +
                      static_cast<size_t>(canonical - 1)];
@@ -148,7 +160,9 @@ LimitTessellation tessellate(const LimitSurface& surface, const TessellationOpti
       for (int j = 0; j < n; ++j) {
         for (int i = 0; i + j < n; ++i) {
           add_triangle(at(i, j), at(i + 1, j), at(i, j + 1), first);
-          if (i + j + 2 <= n) add_triangle(at(i + 1, j), at(i + 1, j + 1), at(i, j + 1), first);
+          if (i + j + 2 <= n) {
+            add_triangle(at(i + 1, j), at(i + 1, j + 1), at(i, j + 1), first);
+          }
         }
       }
       continue;

@@ -33,7 +33,9 @@ BakeResult bake_texture(const TargetSamples& samples, const LimitSurface& target
   if (!target.control_mesh().has_texcoords()) {
     throw InvalidInputError(target.name(), "has no texture coordinates to bake into");
   }
-  if (target_image.empty()) throw InvalidInputError(name, "the target image is empty");
+  if (target_image.empty()) {
+    throw InvalidInputError(name, "the target image is empty");
+  }
   if (!(options.alpha >= 0.0f && options.alpha <= 1.0f)) {
     throw InvalidInputError(name, "alpha must be in [0, 1]");
   }
@@ -64,15 +66,18 @@ BakeResult bake_texture(const TargetSamples& samples, const LimitSurface& target
                     std::numeric_limits<float>::infinity());
     std::map<std::pair<int, int>, int> count;
     for (const Eigen::Vector3i& c : samples.triangles) {
-      for (int k = 0; k < 3; ++k)
+      for (int k = 0; k < 3; ++k) {
         ++count[{std::min(c[k], c[(k + 1) % 3]), std::max(c[k], c[(k + 1) % 3])}];
+      }
     }
     const double band = options.feather + 1.0;
     for (size_t t = 0; t < nt; ++t) {
       const Eigen::Vector3i& c = samples.triangles[t];
       for (int k = 0; k < 3; ++k) {
         const int a = c[k], b = c[(k + 1) % 3];
-        if (count[{std::min(a, b), std::max(a, b)}] != 1) continue;
+        if (count[{std::min(a, b), std::max(a, b)}] != 1) {
+          continue;
+        }
         const Eigen::Vector2d& pa = pixel[t][static_cast<size_t>(k)];
         const Eigen::Vector2d& pb = pixel[t][static_cast<size_t>((k + 1) % 3)];
         const int x0 = std::max(0, static_cast<int>(std::floor(std::min(pa.x(), pb.x()) - band)));
@@ -99,24 +104,30 @@ BakeResult bake_texture(const TargetSamples& samples, const LimitSurface& target
   std::vector<Eigen::Vector4f> source_color(samples.sources.size(), Eigen::Vector4f::Zero());
   std::vector<char> has(samples.sources.size(), 0);
   for (size_t i = 0; i < samples.sources.size(); ++i) {
-    if (!samples.sources[i].inside) continue;
+    if (!samples.sources[i].inside) {
+      continue;
+    }
     has[i] = 1;
-    if (texture)
+    if (texture) {
       source_uv[i] = source.texcoord(samples.sources[i].point);
-    else
+    } else {
       source_color[i] = source.color(samples.sources[i].point);
+    }
   }
 
   std::vector<char> painted(static_cast<size_t>(width) * static_cast<size_t>(height), 0);
   for (size_t t = 0; t < nt; ++t) {
     const Eigen::Vector3i& c = samples.triangles[t];
     if (!has[static_cast<size_t>(c[0])] || !has[static_cast<size_t>(c[1])] ||
-        !has[static_cast<size_t>(c[2])])
+        !has[static_cast<size_t>(c[2])]) {
       continue;
+    }
     const auto& p = pixel[t];
     const Eigen::Vector2d e1 = p[1] - p[0], e2 = p[2] - p[0];
     const double det = e1.x() * e2.y() - e1.y() * e2.x();
-    if (det == 0.0) continue;  // zero area in texture space: covers no texel centre
+    if (det == 0.0) {
+      continue;  // zero area in texture space: covers no texel centre
+    }
     const int x0 =
         std::max(0, static_cast<int>(std::ceil(std::min({p[0].x(), p[1].x(), p[2].x()}))));
     const int x1 =
@@ -134,7 +145,9 @@ BakeResult bake_texture(const TargetSamples& samples, const LimitSurface& target
         const double b1 = (d.x() * e2.y() - d.y() * e2.x()) / det;
         const double b2 = (e1.x() * d.y() - e1.y() * d.x()) / det;
         const double b0 = 1.0 - b1 - b2;
-        if (b0 < kEdge || b1 < kEdge || b2 < kEdge) continue;
+        if (b0 < kEdge || b1 < kEdge || b2 < kEdge) {
+          continue;
+        }
         Eigen::Vector4f src;
         if (texture) {
           const Eigen::Vector2d uv = b0 * source_uv[static_cast<size_t>(c[0])] +
@@ -163,9 +176,13 @@ BakeResult bake_texture(const TargetSamples& samples, const LimitSurface& target
     }
   }
   for (size_t i = 0; i < painted.size(); ++i) {
-    if (!painted[i]) continue;
+    if (!painted[i]) {
+      continue;
+    }
     ++result.texels_painted;
-    if (result.image.pixels[i] != target_image.pixels[i]) ++result.texels_changed;
+    if (result.image.pixels[i] != target_image.pixels[i]) {
+      ++result.texels_changed;
+    }
   }
   return result;
 }

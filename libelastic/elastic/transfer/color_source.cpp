@@ -33,7 +33,9 @@ std::vector<std::pair<int, double>> control_vertex_weights(const LimitSurface& s
   w.emplace_back(vertex(i), w00 + 0.5 * w10 + 0.5 * w01);
   w.emplace_back(vertex(i + 1), 0.5 * w10);
   w.emplace_back(vertex(i - 1), 0.5 * w01);
-  for (int k = 0; k < n; ++k) w.emplace_back(vertex(k), w11 / n);
+  for (int k = 0; k < n; ++k) {
+    w.emplace_back(vertex(k), w11 / n);
+  }
   return w;
 }
 
@@ -78,7 +80,9 @@ Eigen::Vector4f ColorSource::color(const SurfacePoint& p) const {
 }
 
 Eigen::Vector2d ColorSource::texcoord(const SurfacePoint& p) const {
-  if (kind_ != ColorSourceKind::Texture) return Eigen::Vector2d::Zero();
+  if (kind_ != ColorSourceKind::Texture) {
+    return Eigen::Vector2d::Zero();
+  }
   return texture_coordinate(*surface_, p);
 }
 
@@ -109,7 +113,9 @@ ColorSource ColorSource::texture(const LimitSurface& surface, Image image,
     throw InvalidInputError(surface.name(),
                             "has no texture coordinates (needed for a texture colour source)");
   }
-  if (image.empty()) throw InvalidInputError(path.string(), "the texture image is empty");
+  if (image.empty()) {
+    throw InvalidInputError(path.string(), "the texture image is empty");
+  }
   ColorSource s;
   s.surface_ = &surface;
   s.kind_ = ColorSourceKind::Texture;
@@ -137,7 +143,9 @@ ColorSource ColorSource::vertex_scalars(const LimitSurface& surface, std::vector
                                 std::to_string(values.size()));
   }
   for (double v : values) {
-    if (!std::isfinite(v)) throw InvalidInputError(surface.name(), "a vertex scalar is not finite");
+    if (!std::isfinite(v)) {
+      throw InvalidInputError(surface.name(), "a vertex scalar is not finite");
+    }
   }
   if (!(hi > lo) || !std::isfinite(hi - lo)) {
     throw InvalidInputError(surface.name(), "the scalar range needs lo < hi");

@@ -40,8 +40,12 @@ std::vector<std::pair<int, int>> boundary_edges(std::span<const Eigen::Vector3i>
   std::vector<std::pair<int, int>> once;
   for (size_t i = 0; i < edges.size();) {
     size_t j = i;
-    while (j < edges.size() && edges[j] == edges[i]) ++j;
-    if (j - i == 1) once.push_back(edges[i]);
+    while (j < edges.size() && edges[j] == edges[i]) {
+      ++j;
+    }
+    if (j - i == 1) {
+      once.push_back(edges[i]);
+    }
     i = j;
   }
   return once;
@@ -60,7 +64,9 @@ void check_triangles(std::span<const Eigen::Vector3i> triangles, size_t n,
 
 std::vector<double> heights_from_image(const Image& image, std::span<const Eigen::Vector2d> uv,
                                        const HeightImageOptions& options) {
-  if (image.empty()) throw InvalidInputError("height image", "the image is empty");
+  if (image.empty()) {
+    throw InvalidInputError("height image", "the image is empty");
+  }
   std::vector<double> heights(uv.size());
   for (size_t i = 0; i < uv.size(); ++i) {
     if (!uv[i].allFinite()) {
@@ -116,7 +122,9 @@ std::vector<double> boundary_distance(std::span<const Eigen::Vector3d> positions
     }
   }
   for (size_t v = 0; v < n; ++v) {
-    if (nearest[v] >= 0) queue.emplace(0.0, static_cast<int>(v));
+    if (nearest[v] >= 0) {
+      queue.emplace(0.0, static_cast<int>(v));
+    }
   }
   // Each vertex inherits its neighbour's nearest boundary edge when that edge is closer than the
   // one it has: the closest-feature analogue of Dijkstra. Distances are true point-segment
@@ -124,7 +132,9 @@ std::vector<double> boundary_distance(std::span<const Eigen::Vector3d> positions
   while (!queue.empty()) {
     const auto [d, v] = queue.top();
     queue.pop();
-    if (d > distance[static_cast<size_t>(v)]) continue;
+    if (d > distance[static_cast<size_t>(v)]) {
+      continue;
+    }
     const std::pair<int, int>& e = edges[static_cast<size_t>(nearest[static_cast<size_t>(v)])];
     for (const int w : neighbours[static_cast<size_t>(v)]) {
       const double dw = segment_distance(positions[static_cast<size_t>(w)],
@@ -153,7 +163,9 @@ DisplacementResult displace_along_normals(std::span<const Eigen::Vector3d> posit
                   std::to_string(n) + " positions, " + std::to_string(normals.size()) +
                   " normals, " + std::to_string(heights.size()) + " heights)");
   }
-  if (!std::isfinite(options.scale)) throw InvalidInputError(name, "scale is not finite");
+  if (!std::isfinite(options.scale)) {
+    throw InvalidInputError(name, "scale is not finite");
+  }
   if (!(options.falloff_width >= 0.0) || !std::isfinite(options.falloff_width)) {
     throw InvalidInputError(name, "falloff width must be finite and >= 0");
   }
@@ -189,7 +201,9 @@ DisplacementResult displace_along_normals(std::span<const Eigen::Vector3d> posit
   }
   if (options.pin_boundary) {
     for (size_t i = 0; i < n; ++i) {
-      if (on_boundary[i]) result.weights[i] = 0.0;
+      if (on_boundary[i]) {
+        result.weights[i] = 0.0;
+      }
     }
   }
 

@@ -17,7 +17,9 @@ namespace elastic {
 DetailField extract_detail(const SurfaceProjector& base, const PolygonMesh& detail,
                            const DetailOptions& options) {
   const int n = detail.num_vertices();
-  if (n == 0) throw InvalidInputError(options.name, "the detail mesh has no vertices");
+  if (n == 0) {
+    throw InvalidInputError(options.name, "the detail mesh has no vertices");
+  }
   for (int i = 0; i < n; ++i) {
     if (!detail.positions[static_cast<size_t>(i)].allFinite()) {
       throw InvalidInputError(options.name,
@@ -38,7 +40,9 @@ DetailField extract_detail(const SurfaceProjector& base, const PolygonMesh& deta
     const Eigen::Vector3d offset = detail.positions[i] - closest[i].position;
     field.local_offsets[i] = frame.to_local(offset);
     field.max_height = std::max(field.max_height, offset.norm());
-    if (closest[i].on_boundary) ++field.on_base_boundary;
+    if (closest[i].on_boundary) {
+      ++field.on_base_boundary;
+    }
   }
   return field;
 }
@@ -46,7 +50,9 @@ DetailField extract_detail(const SurfaceProjector& base, const PolygonMesh& deta
 PasteDetailResult paste_detail(const DetailField& field, const Mapping& mapping,
                                const MapDifferential& differential,
                                const PasteDetailOptions& options) {
-  if (!std::isfinite(options.scale)) throw InvalidInputError(options.name, "scale is not finite");
+  if (!std::isfinite(options.scale)) {
+    throw InvalidInputError(options.name, "scale is not finite");
+  }
   const size_t n = field.base_points.size();
   if (field.mesh.positions.size() != n || field.local_offsets.size() != n) {
     throw InvalidInputError(options.name, "the detail field's arrays disagree with its mesh");
@@ -60,7 +66,9 @@ PasteDetailResult paste_detail(const DetailField& field, const Mapping& mapping,
   tbb::parallel_for(tbb::blocked_range<size_t>(0, n), [&](const tbb::blocked_range<size_t>& r) {
     for (size_t i = r.begin(); i != r.end(); ++i) {
       const Mapping::Location image = mapping.forward(field.base_points[i]);
-      if (!image.inside) continue;
+      if (!image.inside) {
+        continue;
+      }
       // The offset back in world coordinates at the base point (x - b), then carried by T.
       const Eigen::Vector3d offset =
           surface_frame(base, field.base_points[i]).to_world(field.local_offsets[i]);
@@ -94,15 +102,21 @@ PasteDetailResult paste_detail(const DetailField& field, const Mapping& mapping,
     for (int c = in.face_offsets[static_cast<size_t>(f)];
          c < in.face_offsets[static_cast<size_t>(f) + 1]; ++c) {
       out.face_vertices.push_back(in.face_vertices[static_cast<size_t>(c)]);
-      if (in.has_texcoords())
+      if (in.has_texcoords()) {
         out.corner_texcoords.push_back(in.corner_texcoords[static_cast<size_t>(c)]);
+      }
     }
     out.face_offsets.push_back(static_cast<int>(out.face_vertices.size()));
-    if (!in.face_materials.empty())
+    if (!in.face_materials.empty()) {
       out.face_materials.push_back(in.face_materials[static_cast<size_t>(f)]);
-    if (in.has_face_colors()) out.face_colors.push_back(in.face_colors[static_cast<size_t>(f)]);
+    }
+    if (in.has_face_colors()) {
+      out.face_colors.push_back(in.face_colors[static_cast<size_t>(f)]);
+    }
   }
-  if (out.face_vertices.empty()) out.face_offsets.clear();
+  if (out.face_vertices.empty()) {
+    out.face_offsets.clear();
+  }
   return result;
 }
 
@@ -114,10 +128,14 @@ Eigen::Vector3d closest_barycentric(const Eigen::Vector3d& p, const Eigen::Vecto
                                     const Eigen::Vector3d& b, const Eigen::Vector3d& c) {
   const Eigen::Vector3d ab = b - a, ac = c - a, ap = p - a;
   const double d1 = ab.dot(ap), d2 = ac.dot(ap);
-  if (d1 <= 0.0 && d2 <= 0.0) return {1, 0, 0};
+  if (d1 <= 0.0 && d2 <= 0.0) {
+    return {1, 0, 0};
+  }
   const Eigen::Vector3d bp = p - b;
   const double d3 = ab.dot(bp), d4 = ac.dot(bp);
-  if (d3 >= 0.0 && d4 <= d3) return {0, 1, 0};
+  if (d3 >= 0.0 && d4 <= d3) {
+    return {0, 1, 0};
+  }
   const double vc = d1 * d4 - d3 * d2;
   if (vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0) {
     const double v = d1 / (d1 - d3);
@@ -125,7 +143,9 @@ Eigen::Vector3d closest_barycentric(const Eigen::Vector3d& p, const Eigen::Vecto
   }
   const Eigen::Vector3d cp = p - c;
   const double d5 = ab.dot(cp), d6 = ac.dot(cp);
-  if (d6 >= 0.0 && d5 <= d6) return {0, 0, 1};
+  if (d6 >= 0.0 && d5 <= d6) {
+    return {0, 0, 1};
+  }
   const double vb = d5 * d2 - d1 * d6;
   if (vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0) {
     const double w = d2 / (d2 - d6);
@@ -172,8 +192,9 @@ class Footprint {
       const Eigen::Vector3i a = cell_of(lo.array() - radius_), b = cell_of(hi.array() + radius_);
       for (int x = a.x(); x <= b.x(); ++x) {
         for (int y = a.y(); y <= b.y(); ++y) {
-          for (int z = a.z(); z <= b.z(); ++z)
+          for (int z = a.z(); z <= b.z(); ++z) {
             cells_[key({x, y, z})].push_back(static_cast<int>(t));
+          }
         }
       }
     }
@@ -182,7 +203,9 @@ class Footprint {
   // The world offset x - b interpolated at p; false when p is off the footprint.
   bool offset_at(const Eigen::Vector3d& p, Eigen::Vector3d& offset) const {
     const auto it = cells_.find(key(cell_of(p)));
-    if (it == cells_.end()) return false;
+    if (it == cells_.end()) {
+      return false;
+    }
     double best = std::numeric_limits<double>::infinity();
     for (const int t : it->second) {
       const std::array<int, 3>& tri = triangles_[static_cast<size_t>(t)];
@@ -236,16 +259,22 @@ DetailSamplesResult paste_detail_on_samples(const DetailField& field,
                             "have one entry per sample (" +
                                 std::to_string(n) + " target points)");
   }
-  if (!std::isfinite(options.scale)) throw InvalidInputError(options.name, "scale is not finite");
+  if (!std::isfinite(options.scale)) {
+    throw InvalidInputError(options.name, "scale is not finite");
+  }
   const Footprint footprint(field, options.footprint_tolerance);
   DetailSamplesResult result;
   result.positions.assign(target_positions.begin(), target_positions.end());
   result.covered.assign(n, 0);
   tbb::parallel_for(tbb::blocked_range<size_t>(0, n), [&](const tbb::blocked_range<size_t>& r) {
     for (size_t i = r.begin(); i != r.end(); ++i) {
-      if (!sources[i].inside || (!pinned.empty() && pinned[i])) continue;
+      if (!sources[i].inside || (!pinned.empty() && pinned[i])) {
+        continue;
+      }
       Eigen::Vector3d offset = Eigen::Vector3d::Zero();
-      if (!footprint.offset_at(sources[i].position, offset)) continue;
+      if (!footprint.offset_at(sources[i].position, offset)) {
+        continue;
+      }
       const Eigen::Matrix3d t = differential.transport(sources[i].point, target_points[i],
                                                        sources[i].triangle, options.tangential);
       result.positions[i] += options.scale * (t * offset);
@@ -253,8 +282,12 @@ DetailSamplesResult paste_detail_on_samples(const DetailField& field,
     }
   });
   for (size_t i = 0; i < n; ++i) {
-    if (!sources[i].inside) ++result.without_source;
-    if (result.covered[i]) ++result.covered_count;
+    if (!sources[i].inside) {
+      ++result.without_source;
+    }
+    if (result.covered[i]) {
+      ++result.covered_count;
+    }
     result.max_displacement =
         std::max(result.max_displacement, (result.positions[i] - target_positions[i]).norm());
   }

@@ -63,10 +63,14 @@ PaintedSurface paint_surface(const LimitSurface& target, const Region& target_re
   if (s.levels > 0 && !s.boundary.empty()) {
     const size_t n = s.boundary.size();
     size_t first = 0;
-    while (first < n && s.boundary[first] >= coarse) ++first;
+    while (first < n && s.boundary[first] >= coarse) {
+      ++first;
+    }
     for (size_t k = 0; k < n && first < n; ++k) {
       const size_t i = (first + k) % n;
-      if (s.boundary[i] >= coarse) continue;
+      if (s.boundary[i] >= coarse) {
+        continue;
+      }
       std::vector<int> between;
       size_t j = (i + 1) % n;
       while (s.boundary[j] >= coarse) {
@@ -75,7 +79,9 @@ PaintedSurface paint_surface(const LimitSurface& target, const Region& target_re
       }
       const int a = out.sample_vertex_index[static_cast<size_t>(s.boundary[i])];
       const int b = out.sample_vertex_index[static_cast<size_t>(s.boundary[j])];
-      if (!between.empty()) segment_points[{a, b}] = std::move(between);
+      if (!between.empty()) {
+        segment_points[{a, b}] = std::move(between);
+      }
     }
   }
 
@@ -101,7 +107,9 @@ PaintedSurface paint_surface(const LimitSurface& target, const Region& target_re
       poly.push_back(p);
       poly_uv.push_back(up);
       const auto it = segment_points.find({q, p});
-      if (it == segment_points.end()) continue;
+      if (it == segment_points.end()) {
+        continue;
+      }
       // Listed from q to p; the m-th from p is at fraction (m + 1) / (count + 1) of p -> q, since
       // the splits are at equal (u, v) steps and ptex faces meet by affine maps along edges.
       const std::vector<int>& between = it->second;
@@ -146,8 +154,9 @@ std::vector<Eigen::Vector4f> transfer_colors(const TargetSamples& samples,
   tbb::parallel_for(tbb::blocked_range<size_t>(0, colors.size()),
                     [&](const tbb::blocked_range<size_t>& r) {
                       for (size_t i = r.begin(); i != r.end(); ++i) {
-                        if (samples.sources[i].inside)
+                        if (samples.sources[i].inside) {
                           colors[i] = source.color(samples.sources[i].point);
+                        }
                       }
                     });
   return colors;
@@ -183,11 +192,15 @@ PolygonMesh make_decal_mesh(const PaintedSurface& painted, const ColorSource& so
   tbb::parallel_for(tbb::blocked_range<size_t>(0, source_uv.size()),
                     [&](const tbb::blocked_range<size_t>& r) {
                       for (size_t i = r.begin(); i != r.end(); ++i) {
-                        if (s.sources[i].inside) source_uv[i] = source.texcoord(s.sources[i].point);
+                        if (s.sources[i].inside) {
+                          source_uv[i] = source.texcoord(s.sources[i].point);
+                        }
                       }
                     });
   const bool target_uv = control.has_texcoords();
-  if (!target_uv) mesh.texcoords.emplace_back(0.0, 0.0);
+  if (!target_uv) {
+    mesh.texcoords.emplace_back(0.0, 0.0);
+  }
   const int sample_base = static_cast<int>(mesh.texcoords.size());
   mesh.texcoords.insert(mesh.texcoords.end(), source_uv.begin(), source_uv.end());
 
@@ -244,7 +257,9 @@ PolygonMesh make_colored_mesh(const PaintedSurface& painted, const ColorSource& 
   const PolygonMesh& control = target.control_mesh();
   PolygonMesh mesh;
   mesh.positions = painted.positions;
-  for (const Eigen::Vector3i& t : painted.triangles) add_triangle_face(mesh, t);
+  for (const Eigen::Vector3i& t : painted.triangles) {
+    add_triangle_face(mesh, t);
+  }
   const std::vector<Eigen::Vector4f> inside = transfer_colors(painted.samples, source);
   mesh.vertex_colors.resize(mesh.positions.size(), outside);
   for (int v = 0; v < painted.num_vertices(); ++v) {

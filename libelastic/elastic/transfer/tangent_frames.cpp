@@ -85,7 +85,9 @@ TriangleFrame triangle_frame(const Eigen::Matrix3d& corners) {
   const Eigen::Vector3d n = f.e1.cross(f.e2);
   const double longest =
       std::max({f.e1.squaredNorm(), f.e2.squaredNorm(), (f.e2 - f.e1).squaredNorm()});
-  if (!(n.norm() > 1e-12 * longest)) return f;
+  if (!(n.norm() > 1e-12 * longest)) {
+    return f;
+  }
   f.normal = n.normalized();
   f.a1 = f.e1.normalized();
   f.a2 = f.normal.cross(f.a1);
@@ -139,10 +141,14 @@ double point_triangle_distance_squared(const Eigen::Vector3d& p, const Eigen::Ve
   // Ericson, Real-Time Collision Detection §5.1.5: closest point by Voronoi regions.
   const Eigen::Vector3d ab = b - a, ac = c - a, ap = p - a;
   const double d1 = ab.dot(ap), d2 = ac.dot(ap);
-  if (d1 <= 0.0 && d2 <= 0.0) return ap.squaredNorm();
+  if (d1 <= 0.0 && d2 <= 0.0) {
+    return ap.squaredNorm();
+  }
   const Eigen::Vector3d bp = p - b;
   const double d3 = ab.dot(bp), d4 = ac.dot(bp);
-  if (d3 >= 0.0 && d4 <= d3) return bp.squaredNorm();
+  if (d3 >= 0.0 && d4 <= d3) {
+    return bp.squaredNorm();
+  }
   const double vc = d1 * d4 - d3 * d2;
   if (vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0) {
     const double v = d1 / (d1 - d3);
@@ -150,7 +156,9 @@ double point_triangle_distance_squared(const Eigen::Vector3d& p, const Eigen::Ve
   }
   const Eigen::Vector3d cp = p - c;
   const double d5 = ab.dot(cp), d6 = ac.dot(cp);
-  if (d6 >= 0.0 && d5 <= d6) return cp.squaredNorm();
+  if (d6 >= 0.0 && d5 <= d6) {
+    return cp.squaredNorm();
+  }
   const double vb = d5 * d2 - d1 * d6;
   if (vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0) {
     const double w = d2 / (d2 - d6);
@@ -170,7 +178,9 @@ double point_triangle_distance_squared(const Eigen::Vector3d& p, const Eigen::Ve
 
 Eigen::Matrix3d triangle_jacobian(const Eigen::Matrix3d& source, const Eigen::Matrix3d& target) {
   const TriangleFrame s = triangle_frame(source);
-  if (!s.ok) throw NumericalError("triangle map", "degenerate source triangle");
+  if (!s.ok) {
+    throw NumericalError("triangle map", "degenerate source triangle");
+  }
   const TriangleFrame t = triangle_frame(target);
   // J = E_t (E_s^T E_s)^-1 E_s^T with E = [e1 e2]: the pseudo-inverse maps the source plane onto
   // edge coordinates and annihilates the source normal. The target may be degenerate (collapsed).
@@ -184,7 +194,9 @@ Eigen::Matrix3d triangle_jacobian(const Eigen::Matrix3d& source, const Eigen::Ma
 Eigen::Matrix3d triangle_rotation(const Eigen::Matrix3d& source, const Eigen::Matrix3d& target) {
   const TriangleFrame s = triangle_frame(source);
   const TriangleFrame t = triangle_frame(target);
-  if (!s.ok || !t.ok) throw NumericalError("triangle map", "degenerate triangle");
+  if (!s.ok || !t.ok) {
+    throw NumericalError("triangle map", "degenerate triangle");
+  }
   const Eigen::Matrix2d q = nearest_orthogonal(planar_jacobian(s, t));
   return plane_basis(t) * q * plane_basis(s).transpose() + t.normal * s.normal.transpose();
 }
@@ -272,7 +284,9 @@ int MapDifferential::nearest_triangle(const Eigen::Vector3d& source_position) co
   int best = -1;
   double best_d2 = std::numeric_limits<double>::infinity();
   for (int k = 0; k < num_triangles(); ++k) {
-    if (degenerate_[static_cast<size_t>(k)]) continue;
+    if (degenerate_[static_cast<size_t>(k)]) {
+      continue;
+    }
     const Eigen::Vector3i& tri = triangles_[static_cast<size_t>(k)];
     const double d2 = point_triangle_distance_squared(
         source_position, source_positions_.col(tri[0]), source_positions_.col(tri[1]),
@@ -282,7 +296,9 @@ int MapDifferential::nearest_triangle(const Eigen::Vector3d& source_position) co
       best = k;
     }
   }
-  if (best < 0) throw NumericalError("map differential", "no usable grid triangle");
+  if (best < 0) {
+    throw NumericalError("map differential", "no usable grid triangle");
+  }
   return best;
 }
 
@@ -291,7 +307,9 @@ Eigen::Matrix3d MapDifferential::transport(const SurfacePoint& source, const Sur
   if (!source_ || !source.valid() || !target.valid()) {
     throw InvalidInputError("map differential", "transport needs a source and a target point");
   }
-  if (triangle < 0) triangle = nearest_triangle(source_->position(source));
+  if (triangle < 0) {
+    triangle = nearest_triangle(source_->position(source));
+  }
   check_triangle(triangle);
   const Eigen::Vector3i& tri = triangles_[static_cast<size_t>(triangle)];
   const Eigen::Vector3d ms =
@@ -315,7 +333,9 @@ Eigen::Matrix3d MapDifferential::transport(const SurfacePoint& source, const Sur
   // rotations_ already maps ms to the triangle's own target normal (flip * mt); replace that
   // normal part by ms -> mt so both modes send the source normal to the target normal.
   Eigen::Matrix3d middle = tangential;
-  if (mode == VectorTransport::Rotation) middle -= flip * mt * ms.transpose();
+  if (mode == VectorTransport::Rotation) {
+    middle -= flip * mt * ms.transpose();
+  }
   middle += mt * ms.transpose();
   return minimal_rotation(mt, nt) * middle * minimal_rotation(ns, ms);
 }
@@ -323,14 +343,18 @@ Eigen::Matrix3d MapDifferential::transport(const SurfacePoint& source, const Sur
 Eigen::Matrix3d MapDifferential::transport_forward(const SurfacePoint& source,
                                                    const Mapping::Location& image,
                                                    VectorTransport mode) const {
-  if (!image.inside) throw InvalidInputError("map differential", "the point maps outside");
+  if (!image.inside) {
+    throw InvalidInputError("map differential", "the point maps outside");
+  }
   return transport(source, image.point, image.triangle, mode);
 }
 
 Eigen::Matrix3d MapDifferential::transport_inverse(const SurfacePoint& target,
                                                    const Mapping::Location& preimage,
                                                    VectorTransport mode) const {
-  if (!preimage.inside) throw InvalidInputError("map differential", "the point has no source");
+  if (!preimage.inside) {
+    throw InvalidInputError("map differential", "the point has no source");
+  }
   return transport(preimage.point, target, preimage.triangle, mode);
 }
 
@@ -369,8 +393,12 @@ VectorTransferResult transfer_vectors(const MapDifferential& differential,
       continue;
     }
     int triangle = from.triangle;
-    if (triangle < 0) triangle = differential.nearest_triangle(from.position);
-    if (differential.folded(triangle)) ++result.folded;
+    if (triangle < 0) {
+      triangle = differential.nearest_triangle(from.position);
+    }
+    if (differential.folded(triangle)) {
+      ++result.folded;
+    }
     const Eigen::Matrix3d t =
         differential.transport(from.point, target_points[i], triangle, options.mode);
     const Eigen::Vector3d world =

@@ -29,7 +29,9 @@ EdgeKey key(int a, int b) {
 double midpoint_lambda(double a, double b, int loop_size) {
   // a -> b follows the loop (boundary edges of counter-clockwise triangles run along it); b may
   // have wrapped past the loop's start.
-  if (b <= a) b += loop_size;
+  if (b <= a) {
+    b += loop_size;
+  }
   const double m = 0.5 * (a + b);
   return m >= loop_size ? m - loop_size : m;
 }
@@ -41,14 +43,18 @@ std::vector<int> boundary_segment_triangles(const Region& region) {
   std::map<EdgeKey, int> directed;  // (from, to) -> triangle
   for (int t = 0; t < region.num_triangles(); ++t) {
     const Eigen::Vector3i& tri = region.triangles[static_cast<size_t>(t)];
-    for (int k = 0; k < 3; ++k) directed[{tri[k], tri[(k + 1) % 3]}] = t;
+    for (int k = 0; k < 3; ++k) {
+      directed[{tri[k], tri[(k + 1) % 3]}] = t;
+    }
   }
   std::vector<int> out(static_cast<size_t>(n), -1);
   for (int k = 0; k < n; ++k) {
     const int a = region.boundary[static_cast<size_t>(k)];
     const int b = region.boundary[static_cast<size_t>((k + 1) % n)];
     const auto it = directed.find({a, b});
-    if (it != directed.end()) out[static_cast<size_t>(k)] = it->second;
+    if (it != directed.end()) {
+      out[static_cast<size_t>(k)] = it->second;
+    }
   }
   return out;
 }
@@ -57,7 +63,9 @@ std::vector<int> boundary_segment_triangles(const Region& region) {
 Eigen::Vector2d corner_uv(const Region& region, int t, int v) {
   const Eigen::Vector3i& tri = region.triangles[static_cast<size_t>(t)];
   for (int k = 0; k < 3; ++k) {
-    if (tri[k] == v) return region.triangle_uv[static_cast<size_t>(t)][static_cast<size_t>(k)];
+    if (tri[k] == v) {
+      return region.triangle_uv[static_cast<size_t>(t)][static_cast<size_t>(k)];
+    }
   }
   return region.points[static_cast<size_t>(v)].uv();
 }
@@ -85,9 +93,10 @@ struct CurveOnSurface {
     const int a = region->boundary[static_cast<size_t>(loc.segment)];
     const int b = region->boundary[static_cast<size_t>((loc.segment + 1) % n)];
     const int t = segment_triangle[static_cast<size_t>(loc.segment)];
-    if (t < 0)
+    if (t < 0) {
       return loc.t < 0.5 ? region->points[static_cast<size_t>(a)]
                          : region->points[static_cast<size_t>(b)];
+    }
     const Eigen::Vector2d uv =
         (1.0 - loc.t) * corner_uv(*region, t, a) + loc.t * corner_uv(*region, t, b);
     return SurfacePoint{region->triangle_face[static_cast<size_t>(t)], uv.x(), uv.y()};
@@ -124,7 +133,9 @@ struct Work {
 void split_all(Work& w, int loop_size) {
   std::map<EdgeKey, int> edge_count;
   for (const Eigen::Vector3i& t : w.triangles) {
-    for (int k = 0; k < 3; ++k) ++edge_count[key(t[k], t[(k + 1) % 3])];
+    for (int k = 0; k < 3; ++k) {
+      ++edge_count[key(t[k], t[(k + 1) % 3])];
+    }
   }
   std::map<EdgeKey, int> midpoint;
   std::vector<Eigen::Vector3i> triangles;
@@ -145,7 +156,9 @@ void split_all(Work& w, int loop_size) {
           0.5 * (cuv[static_cast<size_t>(k)] + cuv[static_cast<size_t>((k + 1) % 3)]);
       const auto [it, fresh] = midpoint.try_emplace(key(a, b), static_cast<int>(w.points.size()));
       m[static_cast<size_t>(k)] = it->second;
-      if (!fresh) continue;
+      if (!fresh) {
+        continue;
+      }
       w.points.push_back(SurfacePoint{w.face[t], muv[static_cast<size_t>(k)].x(),
                                       muv[static_cast<size_t>(k)].y()});
       const double la = w.lambda[static_cast<size_t>(a)], lb = w.lambda[static_cast<size_t>(b)];
@@ -180,7 +193,9 @@ double longest_edge(const std::vector<Eigen::Vector3d>& x, const Eigen::Vector3i
 
 // Levels needed to bring `length` down to `limit` by halving.
 int levels_for(double length, double limit) {
-  if (!(limit > 0.0) || length <= limit) return 0;
+  if (!(limit > 0.0) || length <= limit) {
+    return 0;
+  }
   return static_cast<int>(std::ceil(std::log2(length / limit) - 1e-12));
 }
 
@@ -233,8 +248,9 @@ TargetSamples sample_target(const Region& region, const Mapping& mapping,
                       });
     for (const Eigen::Vector3i& t : region.triangles) {
       if (!has[static_cast<size_t>(t[0])] || !has[static_cast<size_t>(t[1])] ||
-          !has[static_cast<size_t>(t[2])])
+          !has[static_cast<size_t>(t[2])]) {
         continue;
+      }
       levels = std::max(levels, levels_for(longest_edge(source, t), options.max_source_edge));
     }
   }
@@ -265,7 +281,9 @@ TargetSamples sample_target(const Region& region, const Mapping& mapping,
       t *= 4;
     }
   }
-  for (int l = 0; l < levels; ++l) split_all(w, loop_size);
+  for (int l = 0; l < levels; ++l) {
+    split_all(w, loop_size);
+  }
   out.levels = levels;
 
   const size_t nv = w.points.size();
@@ -274,7 +292,9 @@ TargetSamples sample_target(const Region& region, const Mapping& mapping,
   out.normals.resize(nv);
   out.sources.resize(nv);
   out.on_boundary.resize(nv);
-  for (size_t i = 0; i < nv; ++i) out.on_boundary[i] = w.lambda[i] >= 0.0;
+  for (size_t i = 0; i < nv; ++i) {
+    out.on_boundary[i] = w.lambda[i] >= 0.0;
+  }
 
   std::optional<CurveOnSurface> target_curve, source_curve;
   if (options.source_region != nullptr && loop_size >= 3 &&
@@ -303,7 +323,9 @@ TargetSamples sample_target(const Region& region, const Mapping& mapping,
     }
   });
   if (source_curve) {
-    for (size_t i = 0; i < nv; ++i) out.boundary_by_arc_length += out.on_boundary[i] ? 1 : 0;
+    for (size_t i = 0; i < nv; ++i) {
+      out.boundary_by_arc_length += out.on_boundary[i] ? 1 : 0;
+    }
   }
 
   const bool relinearise = source_surface != nullptr && options.source_particles.cols() > 0 &&
@@ -318,7 +340,9 @@ TargetSamples sample_target(const Region& region, const Mapping& mapping,
     }
   }
   for (size_t i = 0; i < nv; ++i) {
-    if (out.sources[i].inside) continue;
+    if (out.sources[i].inside) {
+      continue;
+    }
     bool found = false;
     if (relinearise) {
       for (int t : vertex_triangles[i]) {
@@ -330,17 +354,23 @@ TargetSamples sample_target(const Region& region, const Mapping& mapping,
             found = true;
           }
         }
-        if (found) break;
+        if (found) {
+          break;
+        }
       }
     }
     for (const double f : {0.1, 0.25, 0.5}) {
-      if (found) break;
+      if (found) {
+        break;
+      }
       for (int t : vertex_triangles[i]) {
         const auto& uv = w.uv[static_cast<size_t>(t)];
         const Eigen::Vector3i& tri = w.triangles[static_cast<size_t>(t)];
         Eigen::Vector2d own = uv[0];
         for (int k = 0; k < 3; ++k) {
-          if (static_cast<size_t>(tri[k]) == i) own = uv[static_cast<size_t>(k)];
+          if (static_cast<size_t>(tri[k]) == i) {
+            own = uv[static_cast<size_t>(k)];
+          }
         }
         const Eigen::Vector2d centroid = (uv[0] + uv[1] + uv[2]) / 3.0;
         const Eigen::Vector2d q = (1.0 - f) * own + f * centroid;
@@ -352,12 +382,15 @@ TargetSamples sample_target(const Region& region, const Mapping& mapping,
           break;
         }
       }
-      if (found) break;
+      if (found) {
+        break;
+      }
     }
-    if (found)
+    if (found) {
       ++out.nudged;
-    else
+    } else {
       ++out.unresolved;
+    }
   }
 
   // Piecewise-linear weights in 3D (see the header), Gauss-Newton onto the source surface.
@@ -369,17 +402,22 @@ TargetSamples sample_target(const Region& region, const Mapping& mapping,
       for (size_t i = r.begin(); i != r.end(); ++i) {
         Mapping::Location& loc = out.sources[i];
         if (!loc.inside || loc.triangle < 0 ||
-            loc.triangle >= static_cast<int>(grid_triangles.size()))
+            loc.triangle >= static_cast<int>(grid_triangles.size())) {
           continue;
+        }
         const Eigen::Vector3i& tri = grid_triangles[static_cast<size_t>(loc.triangle)];
-        if (tri.maxCoeff() >= tp.cols()) continue;
+        if (tri.maxCoeff() >= tp.cols()) {
+          continue;
+        }
         const Eigen::Vector3d t0 = tp.col(tri[0]);
         const Eigen::Vector3d e1 = tp.col(tri[1]) - t0, e2 = tp.col(tri[2]) - t0;
         const Eigen::Vector3d d = out.positions[i] - t0;
         // Normal equations of min |b1 e1 + b2 e2 - d|: the projection onto the triangle's plane.
         const double g11 = e1.dot(e1), g12 = e1.dot(e2), g22 = e2.dot(e2);
         const double det = g11 * g22 - g12 * g12;
-        if (!(det > 1e-24 * g11 * g22)) continue;  // degenerate particle triangle: keep the inverse
+        if (!(det > 1e-24 * g11 * g22)) {
+          continue;  // degenerate particle triangle: keep the inverse
+        }
         const double r1 = e1.dot(d), r2 = e2.dot(d);
         const double b1 = (g22 * r1 - g12 * r2) / det, b2 = (g11 * r2 - g12 * r1) / det;
         const Eigen::Vector3d weights(1.0 - b1 - b2, b1, b2);
@@ -393,11 +431,15 @@ TargetSamples sample_target(const Region& region, const Mapping& mapping,
           const Eigen::Vector3d residual = y - der.position;
           const double a11 = der.du.dot(der.du), a12 = der.du.dot(der.dv), a22 = der.dv.dot(der.dv);
           const double adet = a11 * a22 - a12 * a12;
-          if (!(adet > 0.0)) break;
+          if (!(adet > 0.0)) {
+            break;
+          }
           const double q1 = der.du.dot(residual), q2 = der.dv.dot(residual);
           const Eigen::Vector2d step((a22 * q1 - a12 * q2) / adet, (a11 * q2 - a12 * q1) / adet);
           p = source_surface->walk(p, step);
-          if (step.norm() < 1e-14) break;
+          if (step.norm() < 1e-14) {
+            break;
+          }
         }
         loc.point = p;
         loc.position = source_surface->position(p);
@@ -409,18 +451,24 @@ TargetSamples sample_target(const Region& region, const Mapping& mapping,
   // Boundary loop of the refined mesh: boundary vertices in loop order.
   std::vector<std::pair<double, int>> loop;
   for (size_t i = 0; i < nv; ++i) {
-    if (w.lambda[i] >= 0.0) loop.emplace_back(w.lambda[i], static_cast<int>(i));
+    if (w.lambda[i] >= 0.0) {
+      loop.emplace_back(w.lambda[i], static_cast<int>(i));
+    }
   }
   std::sort(loop.begin(), loop.end());
   out.boundary.reserve(loop.size());
-  for (const auto& entry : loop) out.boundary.push_back(entry.second);
+  for (const auto& entry : loop) {
+    out.boundary.push_back(entry.second);
+  }
 
   out.triangles = std::move(w.triangles);
   out.triangle_face = std::move(w.face);
   out.triangle_uv = std::move(w.uv);
   out.triangle_parent = std::move(w.parent);
   std::vector<Eigen::Vector3d> source_positions(nv);
-  for (size_t i = 0; i < nv; ++i) source_positions[i] = out.sources[i].position;
+  for (size_t i = 0; i < nv; ++i) {
+    source_positions[i] = out.sources[i].position;
+  }
   for (const Eigen::Vector3i& t : out.triangles) {
     out.max_edge_length = std::max(out.max_edge_length, longest_edge(out.positions, t));
     if (out.sources[static_cast<size_t>(t[0])].inside &&
@@ -434,7 +482,9 @@ TargetSamples sample_target(const Region& region, const Mapping& mapping,
 }
 
 double source_texel_length(const Region& region, int columns, int rows) {
-  if (region.texcoords.size() != region.positions.size() || columns <= 0 || rows <= 0) return 0.0;
+  if (region.texcoords.size() != region.positions.size() || columns <= 0 || rows <= 0) {
+    return 0.0;
+  }
   double texture_area = 0.0;
   for (const Eigen::Vector3i& t : region.triangles) {
     const Eigen::Vector2d& a = region.texcoords[static_cast<size_t>(t[0])];
@@ -443,7 +493,9 @@ double source_texel_length(const Region& region, int columns, int rows) {
     texture_area += 0.5 * std::abs(e1.x() * e2.y() - e1.y() * e2.x());
   }
   const double texels = texture_area * static_cast<double>(columns) * static_cast<double>(rows);
-  if (!(texels > 0.0)) return 0.0;
+  if (!(texels > 0.0)) {
+    return 0.0;
+  }
   return std::sqrt(region.area() / texels);
 }
 

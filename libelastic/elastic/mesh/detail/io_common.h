@@ -26,11 +26,15 @@ class LineScanner {
 
   /// The next line without its line end; false at the end of the text.
   bool next(std::string_view& line) {
-    if (pos_ >= text_.size()) return false;
+    if (pos_ >= text_.size()) {
+      return false;
+    }
     const size_t end = text_.find('\n', pos_);
     const size_t stop = end == std::string_view::npos ? text_.size() : end;
     line = text_.substr(pos_, stop - pos_);
-    if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
+    if (!line.empty() && line.back() == '\r') {
+      line.remove_suffix(1);
+    }
     pos_ = end == std::string_view::npos ? text_.size() : end + 1;
     ++line_;
     return true;
@@ -59,9 +63,13 @@ inline bool is_space(char c) {
 /// Removes and returns the next whitespace-separated token of `rest` (empty when none is left).
 inline std::string_view next_token(std::string_view& rest) {
   size_t i = 0;
-  while (i < rest.size() && is_space(rest[i])) ++i;
+  while (i < rest.size() && is_space(rest[i])) {
+    ++i;
+  }
   size_t j = i;
-  while (j < rest.size() && !is_space(rest[j])) ++j;
+  while (j < rest.size() && !is_space(rest[j])) {
+    ++j;
+  }
   const std::string_view token = rest.substr(i, j - i);
   rest.remove_prefix(j);
   return token;
@@ -69,24 +77,36 @@ inline std::string_view next_token(std::string_view& rest) {
 
 /// `rest` without leading and trailing whitespace.
 inline std::string_view trim(std::string_view rest) {
-  while (!rest.empty() && is_space(rest.front())) rest.remove_prefix(1);
-  while (!rest.empty() && is_space(rest.back())) rest.remove_suffix(1);
+  while (!rest.empty() && is_space(rest.front())) {
+    rest.remove_prefix(1);
+  }
+  while (!rest.empty() && is_space(rest.back())) {
+    rest.remove_suffix(1);
+  }
   return rest;
 }
 
 /// Parses a whole token as a double (a leading '+' allowed, as C's strtod does); false if it is not
 /// one.
 inline bool parse_double(std::string_view token, double& value) {
-  if (!token.empty() && token.front() == '+') token.remove_prefix(1);
-  if (token.empty()) return false;
+  if (!token.empty() && token.front() == '+') {
+    token.remove_prefix(1);
+  }
+  if (token.empty()) {
+    return false;
+  }
   const auto [end, ec] = std::from_chars(token.data(), token.data() + token.size(), value);
   return ec == std::errc() && end == token.data() + token.size();
 }
 
 /// Parses a whole token as an int; false if it is not one or out of range.
 inline bool parse_int(std::string_view token, long long& value) {
-  if (!token.empty() && token.front() == '+') token.remove_prefix(1);
-  if (token.empty()) return false;
+  if (!token.empty() && token.front() == '+') {
+    token.remove_prefix(1);
+  }
+  if (token.empty()) {
+    return false;
+  }
   const auto [end, ec] = std::from_chars(token.data(), token.data() + token.size(), value);
   return ec == std::errc() && end == token.data() + token.size();
 }
@@ -95,7 +115,9 @@ inline bool parse_int(std::string_view token, long long& value) {
 inline double expect_double(std::string_view& rest, const LineScanner& scanner, const char* what) {
   const std::string_view token = next_token(rest);
   double value = 0.0;
-  if (token.empty()) scanner.fail(std::string("missing ") + what);
+  if (token.empty()) {
+    scanner.fail(std::string("missing ") + what);
+  }
   if (!parse_double(token, value)) {
     scanner.fail("cannot parse " + std::string(what) + " '" + std::string(token) + "'");
   }
@@ -105,7 +127,9 @@ inline double expect_double(std::string_view& rest, const LineScanner& scanner, 
 inline long long expect_int(std::string_view& rest, const LineScanner& scanner, const char* what) {
   const std::string_view token = next_token(rest);
   long long value = 0;
-  if (token.empty()) scanner.fail(std::string("missing ") + what);
+  if (token.empty()) {
+    scanner.fail(std::string("missing ") + what);
+  }
   if (!parse_int(token, value)) {
     scanner.fail("cannot parse " + std::string(what) + " '" + std::string(token) + "'");
   }
