@@ -2,8 +2,8 @@
 // curvature-adaptive sampling (eqs. 6-8) on the boundary region of the procedural cap (a spherical
 // cap: constant curvature, so the adaptive iteration is Laplacian smoothing of the grid on the
 // sphere). Timed: the sampling call; the surface, magnet and region are built once. Counters:
-// particles, adaptive iterations, converged (1/0), largest last move (in mean spring lengths),
-// rejected moves.
+// particles, adaptive_iterations (not "iterations": Google Benchmark's own key), converged (1/0),
+// largest last move (in mean spring lengths), rejected moves.
 //
 //   bench_sampling --benchmark_filter=Adaptive
 
@@ -41,7 +41,7 @@ const Cap& cap() {
 
 void report(benchmark::State& state, const SampleRegionResult& result) {
   state.counters["particles"] = result.grid.num_particles();
-  state.counters["iterations"] = result.sampling.iterations;
+  state.counters["adaptive_iterations"] = result.sampling.iterations;
   state.counters["converged"] = result.sampling.converged ? 1.0 : 0.0;
   state.counters["max_move"] = result.sampling.max_move;
   state.counters["rejected"] = static_cast<double>(result.sampling.rejected_moves);
