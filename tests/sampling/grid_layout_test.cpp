@@ -191,6 +191,31 @@ TEST(GridLayout, FacesValidOnPlaneAndBump) {
   expect_valid_faces(layout_particle_grid(region, options).grid, bump, 0.05);
 }
 
+// docs/sampling.md's guarantee: every face has a corner that can move. The square region's four
+// corners are where the band triangulation alone makes triangles of three boundary particles (the
+// corner particle and its two neighbours); the layout must have added free points there.
+TEST(GridLayout, NoFaceHasEveryCornerOnTheBoundary) {
+  PlaneFixture plane;
+  for (const long n : {200L, 1000L, 3000L, 12000L}) {
+    GridLayoutOptions options;
+    options.particles = n;
+    const GridLayoutResult layout = layout_particle_grid(plane.region, options);
+    const ParticleGrid& grid = layout.grid;
+    int all_boundary = 0;
+    for (const auto fh : grid.mesh.faces()) {
+      bool free_corner = false;
+      for (const auto vh : grid.mesh.fv_range(fh)) {
+        free_corner = free_corner || !grid.is_boundary[static_cast<size_t>(vh.idx())];
+      }
+      all_boundary += free_corner ? 0 : 1;
+    }
+    EXPECT_EQ(all_boundary, 0) << "N = " << n;
+    EXPECT_GE(layout.band_points, 1) << "N = " << n << ": the square's corners need free points";
+    EXPECT_EQ(layout.interior_particles + layout.boundary_particles, grid.num_particles());
+    expect_valid_faces(grid, plane.surface, 0.05);
+  }
+}
+
 TEST(GridLayout, CountsAndFacesOnSphereCapAndTorus) {
   const LimitSurface sphere(make_sphere(ShapeOptions{.faces = ShapeFaces::Quads, .resolution = 8}));
   const SurfaceProjector sphere_projector(sphere);

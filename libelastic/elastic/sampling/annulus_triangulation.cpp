@@ -50,9 +50,15 @@ AnnulusTriangulation triangulate_annulus(const std::vector<Eigen::Vector2d>& poi
       handles[index] = vh;
     }
   }
+  for (const int index : options.steiner) {
+    const Eigen::Vector2d& p = points.at(static_cast<size_t>(index));
+    const Cdt::Vertex_handle vh = cdt.insert(Kernel::Point_2(p.x(), p.y()));
+    vh->info() = index;
+  }
+  const size_t expected = outer.size() + inner.size() + options.steiner.size();
   // Inserting a point that is already there returns the existing vertex: fewer vertices than points
   // means two points coincide.
-  if (cdt.number_of_vertices() != outer.size() + inner.size()) {
+  if (cdt.number_of_vertices() != expected) {
     throw InvalidInputError(options.name,
                             "band triangulation: two boundary or outline points coincide");
   }
@@ -67,7 +73,7 @@ AnnulusTriangulation triangulate_annulus(const std::vector<Eigen::Vector2d>& poi
     throw InvalidInputError(options.name,
                             "band triangulation: the grid outline crosses the boundary");
   }
-  if (cdt.number_of_vertices() != outer.size() + inner.size()) {
+  if (cdt.number_of_vertices() != expected) {
     throw InvalidInputError(options.name,
                             "band triangulation: the grid outline crosses the boundary");
   }

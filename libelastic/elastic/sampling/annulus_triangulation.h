@@ -20,6 +20,10 @@ namespace elastic {
 struct AnnulusTriangulationOptions {
   /// Name used in error messages.
   std::string name = "annulus";
+  /// Extra points (indices into the caller's point array) strictly inside the band, inserted as
+  /// free vertices of the triangulation (no constraint edges). The grid layout adds them where a
+  /// triangle would otherwise have all three corners on the outer loop.
+  std::vector<int> steiner;
 };
 
 struct AnnulusTriangulation {
@@ -28,7 +32,8 @@ struct AnnulusTriangulation {
 };
 
 /// Triangulates the region between `outer` and `inner`, both counter-clockwise loops of indices
-/// into `points` (not repeated at the end), `inner` strictly inside `outer`. \throws
+/// into `points` (not repeated at the end), `inner` strictly inside `outer`, with the optional
+/// free points `options.steiner` in between. \throws
 /// InvalidInputError naming options.name when a loop has fewer than 3 vertices, two used points
 ///         coincide, or the polygons' edges cross each other (the band would need new points).
 AnnulusTriangulation triangulate_annulus(const std::vector<Eigen::Vector2d>& points,

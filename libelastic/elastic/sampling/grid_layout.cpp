@@ -330,6 +330,51 @@ Lattice build_lattice(const Region& region, const ScaledFlattening& flat,
   return L;
 }
 
+// The band triangulation of step 4 with the guarantee of docs/sampling.md: no triangle has all
+// three corners on the boundary (such a triangle could not move at all while the boundary is held,
+// and where the boundary turns sharply, at a rectangle's corner or a polygon's vertex, its
+// corners land nearly collinear on a smooth target curve: a fold no relaxation can undo). Each
+// such triangle gets a free point at its centroid, strictly inside it and so inside the band, and
+// the band is triangulated again with those points; repeated until none is left (one round in
+// practice: a free point's triangles all have it as a corner).
+struct BandTriangulation {
+  std::vector<Eigen::Vector3i> triangles;  ///< indices: points, then boundary, then steiner
+  std::vector<Eigen::Vector2d> steiner;    ///< the free points added, in index order
+};
+
+BandTriangulation triangulate_band(const std::vector<Eigen::Vector2d>& flat_positions, int interior,
+                                   const std::vector<int>& boundary_ids,
+                                   const std::vector<int>& outline, const std::string& name) {
+  constexpr int kMaxRounds = 4;
+  const int m = static_cast<int>(boundary_ids.size());
+  std::vector<Eigen::Vector2d> points = flat_positions;
+  BandTriangulation band;
+  AnnulusTriangulationOptions options{.name = name, .steiner = {}};
+  for (int round = 0;; ++round) {
+    band.triangles = triangulate_annulus(points, boundary_ids, outline, options).triangles;
+    const auto on_boundary = [&](int index) { return index >= interior && index < interior + m; };
+    int added = 0;
+    for (const Eigen::Vector3i& t : band.triangles) {
+      if (on_boundary(t[0]) && on_boundary(t[1]) && on_boundary(t[2])) {
+        const Eigen::Vector2d centroid = (points[t[0]] + points[t[1]] + points[t[2]]) / 3.0;
+        options.steiner.push_back(static_cast<int>(points.size()));
+        points.push_back(centroid);
+        band.steiner.push_back(centroid);
+        ++added;
+      }
+    }
+    if (added == 0) {
+      return band;
+    }
+    if (round + 1 == kMaxRounds) {
+      throw NumericalError(name,
+                           "grid layout: band triangles with every corner on the boundary "
+                           "remain after " +
+                               std::to_string(kMaxRounds) + " rounds");
+    }
+  }
+}
+
 }  // namespace
 
 GridLayoutResult layout_particle_grid(const Region& region, const GridLayoutOptions& options) {
@@ -433,7 +478,7 @@ GridLayoutResult layout_particle_grid(const Region& region, const GridLayoutOpti
       regular.push_back(around == 4 ? 1 : 0);
     }
   }
-  const int interior = static_cast<int>(flat_positions.size());
+  int interior = static_cast<int>(flat_positions.size());  // lattice points; + band points below
   const int m = static_cast<int>(L.boundary.size());
   for (int k = 0; k < m; ++k) {
     flat_positions.push_back(L.boundary2d[k]);
@@ -484,8 +529,24 @@ GridLayoutResult layout_particle_grid(const Region& region, const GridLayoutOpti
   for (int k = 0; k < m; ++k) {
     boundary_ids[k] = interior + k;
   }
-  const AnnulusTriangulation band = triangulate_annulus(
-      flat_positions, boundary_ids, outline, AnnulusTriangulationOptions{.name = options.name});
+  BandTriangulation band =
+      triangulate_band(flat_positions, interior, boundary_ids, outline, options.name);
+  // Renumber: lattice points, then the band's free points, then the boundary particles in curve
+  // order (the numbering the rest of the layout and ParticleGrid expect).
+  const int steiner = static_cast<int>(band.steiner.size());
+  for (Eigen::Vector3i& t : band.triangles) {
+    for (int c = 0; c < 3; ++c) {
+      if (t[c] >= interior + m) {
+        t[c] -= m;  // free band point s: interior + m + s -> interior + s
+      } else if (t[c] >= interior) {
+        t[c] += steiner;  // boundary particle k: interior + k -> interior + steiner + k
+      }
+    }
+  }
+  flat_positions.insert(flat_positions.begin() + interior, band.steiner.begin(),
+                        band.steiner.end());
+  regular.insert(regular.begin() + interior, static_cast<size_t>(steiner), char(0));
+  interior += steiner;
 
   // Surface points: interior particles through the flattening, boundary particles from the curve.
   GridLayoutResult result;
@@ -553,6 +614,7 @@ GridLayoutResult layout_particle_grid(const Region& region, const GridLayoutOpti
 
   result.spacing = L.h;
   result.interior_particles = interior;
+  result.band_points = steiner;
   result.boundary_particles = m;
   result.quads = static_cast<int>(quads.size());
   result.band_triangles = static_cast<int>(band.triangles.size());

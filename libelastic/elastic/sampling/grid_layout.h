@@ -20,7 +20,10 @@
 ///    farthest point of a square from its nearest corner is its centre, h/sqrt(2) away), so the
 ///    outline lies strictly inside the polygon.
 /// 4. The band between the outline and the boundary polygon is triangulated by constrained Delaunay
-///    (annulus_triangulation.h): no new points, no degenerate or inverted triangles.
+///    (annulus_triangulation.h): no degenerate or inverted triangles. Guarantee: no band triangle
+///    has all three corners on the boundary. Where one would (at a sharp turn of the boundary: a
+///    rectangle's corner, a polygon's vertex), a free particle is added at its centroid and the
+///    band is triangulated again, so every face of the grid has a corner that can move.
 /// 5. h is found by a secant/bisection search on the *actual* count (lattice vertices of the quads
 /// plus
 ///    M) so that it is within `count_tolerance` of the request.
@@ -67,6 +70,9 @@ struct GridLayoutResult {
   int boundary_particles = 0;  ///< M, on the boundary curve
   int quads = 0;               ///< grid faces that are lattice cells
   int band_triangles = 0;      ///< triangles joining the grid outline to the boundary particles
+  /// Free particles added inside the band where a triangle would have had every corner on the
+  /// boundary (counted in interior_particles; numbered after the lattice points).
+  int band_points = 0;
   double count_error = 0.0;    ///< (particles - N) / N
   int search_steps = 0;        ///< lattice counts done by the spacing search
   FlatteningMethod flattening = FlatteningMethod::Conformal;  ///< the flattening actually used
