@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <random>
 
 #include "elastic/core/error.h"
@@ -73,6 +74,67 @@ TEST(SpringEnergy, AngularGradientMatchesFiniteDifferences) {
         x, kStep, [&](const Eigen::Matrix3Xd& y) { return system.evaluate(y).total(); });
     EXPECT_LT((fd - gradient).norm(), kRelative * gradient.norm()) << "seed " << seed;
   }
+}
+
+// The injectivity barrier: configurations compressed enough that many triangles are below the
+// threshold (amplitude 0.45 of the spacing), with springs off so the barrier is tested alone.
+TEST(SpringEnergy, BarrierGradientMatchesFiniteDifferences) {
+  const ParticleGrid grid = test::make_quad_grid(4, 3, 1.0);
+  const SpringEnergyOptions options{.stiffness = 1.0,
+                                    .angular_stiffness = 0.0,
+                                    .rest_scale = 1.2,
+                                    .barrier_stiffness = 0.7,
+                                    .barrier_sigma = 0.6};
+  SpringSystem system(grid, options);
+  const SpringSystem springs_only(grid,
+                                  {.stiffness = 1.0, .angular_stiffness = 0.0, .rest_scale = 1.2});
+  int tested = 0;
+  for (unsigned seed = 1; seed <= 8; ++seed) {
+    Eigen::Matrix3Xd x = random_configuration(grid, 0.3, seed);
+    x.row(2).setZero();  // planar, so the +z normal decides which triangles are inverted
+    Eigen::Matrix3Xd normals = Eigen::Matrix3Xd::Zero(3, x.cols());
+    normals.row(2).setOnes();
+    if (system.set_barrier_mask(x, normals) > 0) {
+      continue;  // an inverted triangle: not the barrier's domain
+    }
+    Eigen::Matrix3Xd gradient, spring_gradient;
+    const SpringEnergies e = system.evaluate(x, &gradient);
+    springs_only.evaluate(x, &spring_gradient);
+    if (!(e.barrier > 0.0)) {
+      continue;
+    }
+    ++tested;
+    const Eigen::Matrix3Xd fd = central_differences(
+        x, 1e-6, [&](const Eigen::Matrix3Xd& y) { return system.evaluate(y).barrier; });
+    const Eigen::Matrix3Xd barrier_gradient = gradient - spring_gradient;
+    EXPECT_LT((fd - barrier_gradient).norm(), 1e-5 * barrier_gradient.norm()) << "seed " << seed;
+  }
+  EXPECT_GE(tested, 2);
+}
+
+// A uniform compression of the whole grid by c (every triangle's stretches are c, c): each barrier
+// triangle has g = 2 / c^2 (with sigma = 1), so E_bar = mu C sum w A (g / g0 - 1)^3 with
+// sum w A = the grid's area (both splits of each quad at weight 1/2) when g > g0, and 0 when not.
+TEST(SpringEnergy, BarrierValueOfAUniformCompression) {
+  const ParticleGrid grid = test::make_quad_grid(4, 3, 1.0);
+  const double mu = 0.5, tau = 0.5, C = 2.0;
+  const SpringSystem system(grid, {.stiffness = C,
+                                   .angular_stiffness = 0.0,
+                                   .rest_scale = 1.0,
+                                   .barrier_stiffness = mu,
+                                   .barrier_sigma = tau});
+  const double area = 12.0, g0 = 1.0 / (tau * tau);
+  for (const double c : {0.2, 0.5, 0.65, 0.9}) {
+    const Eigen::Matrix3Xd x = c * test::grid_positions(grid);
+    const double g = 2.0 / (c * c);
+    const double r = g / g0 - 1.0;
+    const double expected = g > g0 ? mu * C * area * r * r * r : 0.0;
+    EXPECT_NEAR(system.evaluate(x).barrier, expected, 1e-10 * (1.0 + expected)) << "c " << c;
+  }
+  // Collapsed onto a line: infinite.
+  Eigen::Matrix3Xd line = test::grid_positions(grid);
+  line.row(1).setZero();
+  EXPECT_TRUE(std::isinf(system.evaluate(line).barrier));
 }
 
 TEST(SpringEnergy, ForcesConserveLinearAndAngularMomentum) {

@@ -5,7 +5,9 @@
 #include <tbb/parallel_reduce.h>
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <string>
 
 #include "elastic/core/error.h"
@@ -43,6 +45,8 @@ void build_incidence(int num_particles, const std::vector<std::pair<int, int>>& 
 
 std::string_view to_string(RestScale mode) {
   switch (mode) {
+    case RestScale::Auto:
+      return "auto";
     case RestScale::Boundary:
       return "boundary";
     case RestScale::Area:
@@ -54,6 +58,9 @@ std::string_view to_string(RestScale mode) {
 }
 
 RestScale parse_rest_scale(std::string_view text, std::string_view input) {
+  if (text == "auto") {
+    return RestScale::Auto;
+  }
   if (text == "boundary") {
     return RestScale::Boundary;
   }
@@ -64,7 +71,7 @@ RestScale parse_rest_scale(std::string_view text, std::string_view input) {
     return RestScale::None;
   }
   throw InvalidInputError(std::string(input), "unknown rest scale '" + std::string(text) +
-                                                  "' (expected boundary, area or none)");
+                                                  "' (expected auto, boundary, area or none)");
 }
 
 double rest_scale_factor(RestScale mode, const RegionSizes& sizes) {
@@ -74,6 +81,9 @@ double rest_scale_factor(RestScale mode, const RegionSizes& sizes) {
     }
   };
   switch (mode) {
+    case RestScale::Auto:
+      return std::min(rest_scale_factor(RestScale::Boundary, sizes),
+                      rest_scale_factor(RestScale::Area, sizes));
     case RestScale::Boundary:
       check(sizes.source_boundary_length, "source boundary length");
       check(sizes.target_boundary_length, "target boundary length");
@@ -159,8 +169,80 @@ SpringSystem::SpringSystem(const ParticleGrid& grid, const SpringEnergyOptions& 
     }
   }
 
+  if (!finite_non_negative(options.barrier_stiffness) ||
+      !(options.barrier_sigma > 0.0 && options.barrier_sigma < 1.0)) {
+    throw InvalidInputError(name,
+                            "barrier stiffness must be finite and non-negative and its "
+                            "threshold in (0, 1)");
+  }
+  if (options.barrier_stiffness > 0.0) {
+    build_barrier(grid);
+  }
+
   spring_force_.resize(3, static_cast<Eigen::Index>(grid.springs.size()));
   angular_force_.resize(3, static_cast<Eigen::Index>(grid.angular_springs.size()));
+}
+
+void SpringSystem::build_barrier(const ParticleGrid& grid) {
+  const auto source = [&](int p) {
+    const auto& q = grid.mesh.point(GridMesh::VertexHandle(p));
+    return Eigen::Vector3d(q[0], q[1], q[2]);
+  };
+  // Corners of one face are consecutive in corners_.
+  for (std::size_t first = 0; first < corners_.size();) {
+    std::size_t end = first;
+    while (end < corners_.size() && corners_[end].face == corners_[first].face) {
+      ++end;
+    }
+    const std::size_t k = end - first;
+    // A triangle once (weight 1); a quad by the four corner triangles of its two splits (1/2).
+    const std::size_t count = k == 3 ? 1 : k;
+    const double weight = k == 3 ? 1.0 : 2.0 / static_cast<double>(k);
+    for (std::size_t c = first; c < first + count; ++c) {
+      const Corner& corner = corners_[c];
+      const Eigen::Vector3d s0 = source(corner.next) - source(corner.i);
+      const Eigen::Vector3d s1 = source(corner.prev) - source(corner.i);
+      const double g00 = s0.dot(s0), g01 = s0.dot(s1), g11 = s1.dot(s1);
+      const double det = g00 * g11 - g01 * g01;
+      if (!(det > 1e-24 * g00 * g11)) {
+        continue;  // a degenerate source triangle has no map to measure
+      }
+      BarrierTriangle t;
+      t.i = corner.i;
+      t.next = corner.next;
+      t.prev = corner.prev;
+      t.weight = weight * 0.5 * std::sqrt(det);  // w A_s, A_s = sqrt(det(S^T S)) / 2
+      t.b00 = g11 / det;
+      t.b01 = -g01 / det;
+      t.b11 = g00 / det;
+      t.source_det = det;
+      barrier_.push_back(t);
+    }
+    first = end;
+  }
+  barrier_active_.assign(barrier_.size(), 1);
+  std::vector<std::pair<int, int>> pairs;
+  pairs.reserve(3 * barrier_.size());
+  for (std::size_t t = 0; t < barrier_.size(); ++t) {
+    const int code = 3 * static_cast<int>(t);
+    pairs.emplace_back(barrier_[t].i, code);
+    pairs.emplace_back(barrier_[t].next, code + 1);
+    pairs.emplace_back(barrier_[t].prev, code + 2);
+  }
+  build_incidence(num_particles_, pairs, barrier_offset_, barrier_entry_);
+  barrier_force_.resize(3, 3 * static_cast<Eigen::Index>(barrier_.size()));
+}
+
+int SpringSystem::set_barrier_mask(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& normals) {
+  int left_out = 0;
+  for (std::size_t t = 0; t < barrier_.size(); ++t) {
+    const BarrierTriangle& b = barrier_[t];
+    const Eigen::Vector3d xi = x.col(b.i);
+    const double orientation = (x.col(b.next) - xi).cross(x.col(b.prev) - xi).dot(normals.col(b.i));
+    barrier_active_[t] = orientation > 0.0 ? 1 : 0;
+    left_out += barrier_active_[t] ? 0 : 1;
+  }
+  return left_out;
 }
 
 SpringEnergies SpringSystem::evaluate(const Eigen::Matrix3Xd& x, Eigen::Matrix3Xd* gradient) const {
@@ -224,6 +306,63 @@ SpringEnergies SpringSystem::evaluate(const Eigen::Matrix3Xd& x, Eigen::Matrix3X
       },
       std::plus<double>());
 
+  // Injectivity barrier (header): mu C w A h(g), g = sigma^2 tr(B G) det(S^T S) / det(G) with
+  // G = T^T T the target Gram matrix. With q = sigma^2 det(S^T S):
+  //   dg/dG00 = q (b00 / D - a G11 / D^2), dg/dG11 = q (b11 / D - a G00 / D^2),
+  //   dg/dG01 = q (2 b01 / D + 2 a G01 / D^2)   (G01 counted once, it appears twice in G),
+  // with a = tr(B G), D = det(G); and G00 = T0.T0, G11 = T1.T1, G01 = T0.T1 give
+  //   dg/dT0 = 2 dg/dG00 T0 + dg/dG01 T1,   dg/dT1 = 2 dg/dG11 T1 + dg/dG01 T0.
+  // A collapsed target triangle (D = 0) has infinite energy: the line search backs off.
+  const double mu = options_.barrier_stiffness * C;
+  if (mu > 0.0 && !barrier_.empty()) {
+    const double g0 = 1.0 / (options_.barrier_sigma * options_.barrier_sigma);
+    energies.barrier = tbb::parallel_deterministic_reduce(
+        tbb::blocked_range<std::size_t>(0, barrier_.size(), kGrain), 0.0,
+        [&](const tbb::blocked_range<std::size_t>& range, double sum) {
+          for (std::size_t t = range.begin(); t != range.end(); ++t) {
+            const BarrierTriangle& b = barrier_[t];
+            const auto col = 3 * static_cast<Eigen::Index>(t);
+            if (want_gradient) {
+              barrier_force_.middleCols<3>(col).setZero();
+            }
+            if (!barrier_active_[t]) {
+              continue;
+            }
+            const Eigen::Vector3d t0 = x.col(b.next) - x.col(b.i);
+            const Eigen::Vector3d t1 = x.col(b.prev) - x.col(b.i);
+            const double G00 = t0.dot(t0), G01 = t0.dot(t1), G11 = t1.dot(t1);
+            const double D = G00 * G11 - G01 * G01;
+            if (!(D > 0.0)) {
+              sum += std::numeric_limits<double>::infinity();
+              continue;
+            }
+            const double a = b.b00 * G00 + 2.0 * b.b01 * G01 + b.b11 * G11;
+            const double q = sigma * sigma * b.source_det;
+            const double g = q * a / D;
+            if (!(g > g0)) {
+              continue;
+            }
+            const double r = g / g0 - 1.0;
+            sum += mu * b.weight * r * r * r;
+            if (want_gradient) {
+              const double dh = mu * b.weight * 3.0 * r * r / g0;  // dE/dg
+              const double D2 = D * D;
+              const double d00 = dh * q * (b.b00 / D - a * G11 / D2);
+              const double d11 = dh * q * (b.b11 / D - a * G00 / D2);
+              const double d01 = dh * q * (2.0 * b.b01 / D + 2.0 * a * G01 / D2);
+              const Eigen::Vector3d f0 = 2.0 * d00 * t0 + d01 * t1;  // dE/dx_next
+              const Eigen::Vector3d f1 = 2.0 * d11 * t1 + d01 * t0;  // dE/dx_prev
+              barrier_force_.col(col) = -(f0 + f1);
+              barrier_force_.col(col + 1) = f0;
+              barrier_force_.col(col + 2) = f1;
+            }
+          }
+          return sum;
+        },
+        std::plus<double>());
+  }
+  const bool with_barrier = mu > 0.0 && !barrier_.empty();
+
   if (want_gradient) {
     // Gather per particle in the fixed incidence order: no races, same bits for any thread count.
     gradient->resize(3, num_particles_);
@@ -245,6 +384,11 @@ SpringEnergies SpringSystem::evaluate(const Eigen::Matrix3Xd& x, Eigen::Matrix3X
                               g -= 0.5 * angular_force_.col(code >> 1);
                             } else {
                               g += angular_force_.col(code >> 1);
+                            }
+                          }
+                          if (with_barrier) {
+                            for (int k = barrier_offset_[p]; k < barrier_offset_[p + 1]; ++k) {
+                              g += barrier_force_.col(barrier_entry_[k]);
                             }
                           }
                           gradient->col(p) = g;

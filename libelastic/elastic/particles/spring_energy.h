@@ -23,6 +23,24 @@
 ///   c (x - x'), the paper's force f^m = c (x' - x). The paper writes the energy without the 1/2;
 ///   we keep its force.
 ///
+/// - injectivity barrier (beyond the paper; SpringEnergyOptions::barrier_stiffness > 0):
+///       E_bar = mu * sum_{triangles t} w_t A_t * h(g_t),   h(g) = (g / g0 - 1)^2 for g > g0, else
+///       0
+///   over every triangle of both triangulations of each quad (weight w = 1/2, so each split covers
+///   the quad once) and every triangle face (w = 1); A_t is the source area and
+///   g_t = s1^-2 + s2^-2 the inverse part of the symmetric Dirichlet energy of the triangle's
+///   affine map divided by sigma (s1, s2 its singular values, as in metrics/map_metrics.h). In
+///   Gram-matrix form, with S, T the 3 x 2 edge matrices of the source and target triangle:
+///       g = sigma^2 tr((S^T S)^-1 T^T T) det(S^T S) / det(T^T T),
+///   smooth in the target positions, infinite as the target triangle collapses (det(T^T T) -> 0),
+///   and zero unless the smaller stretch falls to about 1/sqrt(g0) = barrier_sigma (g0 =
+///   barrier_sigma^-2): it leaves every triangle that is not close to collapse alone, so the
+///   paper's minimum is unchanged wherever it is not degenerate. It is the barrier of Smith and
+///   Schaefer 2015 (bijective parameterisation with free boundaries) restricted to a threshold:
+///   combined with a line search that rejects inverted triangles it keeps every triangle's
+///   sigma_min away from 0 (no slivers under compression), and so no triangle can fold. Triangles
+///   already inverted where the barrier is switched on (set_barrier_mask) are left out of it.
+///
 /// Degenerate springs: at |d| = 0 (or |e| = 0) the energy has a cone point and no gradient; that
 /// spring then contributes zero to the gradient (a valid subgradient choice that keeps the sum of
 /// forces zero).
@@ -41,14 +59,20 @@ namespace elastic {
 
 /// How the rest lengths are scaled when the source and target regions differ in size.
 enum class RestScale {
-  Boundary,  ///< sigma = target boundary length / source boundary length (the default)
+  /// sigma = min(Boundary, Area): the largest scale that compresses neither the boundary nor the
+  /// region as a whole (the default). A grid whose rest lengths do not fit the target buckles:
+  /// with the boundary held, a target region smaller than sigma^2 times the source's area can
+  /// only take the excess by slivers or folds, while stretch is spread smoothly. Whichever of the
+  /// two ratios is smaller is the one that fits.
+  Auto,
+  Boundary,  ///< sigma = target boundary length / source boundary length (the paper's Table 1)
   Area,      ///< sigma = sqrt(target area / source area)
   None       ///< sigma = 1: absolute sizes are kept
 };
 
-/// "boundary", "area", "none".
+/// "auto", "boundary", "area", "none".
 std::string_view to_string(RestScale mode);
-/// Parses "boundary", "area", "none". \throws InvalidInputError naming `input` otherwise.
+/// Parses "auto", "boundary", "area", "none". \throws InvalidInputError naming `input` otherwise.
 RestScale parse_rest_scale(std::string_view text, std::string_view input = "rest scale");
 
 /// Sizes of the two regions that the rest-scale factor compares.
@@ -67,13 +91,20 @@ struct SpringEnergyOptions {
   double stiffness = 1.0;          ///< C, normal springs (eq. 13)
   double angular_stiffness = 1.0;  ///< C_a, angular springs
   double rest_scale = 1.0;         ///< sigma, multiplies every rest value
+  /// mu of the injectivity barrier E_bar (see the file comment), relative to C: the barrier's
+  /// weight is mu * C. 0: off, the paper's energy E_len + E_ang alone.
+  double barrier_stiffness = 0.0;
+  /// The smaller stretch (divided by sigma) below which the barrier starts to act, about; in
+  /// (0, 1).
+  double barrier_sigma = 0.4;
 };
 
 /// Energies per term.
 struct SpringEnergies {
   double length = 0.0;   ///< E_len (eq. 13)
   double angular = 0.0;  ///< E_ang
-  double total() const { return length + angular; }
+  double barrier = 0.0;  ///< E_bar (0 when the barrier is off)
+  double total() const { return length + angular + barrier; }
 };
 
 /// The spring energies of one ParticleGrid, with the incidence tables precomputed for fast,
@@ -102,6 +133,13 @@ class SpringSystem {
   void folded_corners(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& normals,
                       std::vector<char>& folded) const;
 
+  /// Leaves out of the barrier every barrier triangle that is inverted at `x` (normals: 3 x #P unit
+  /// surface normals, the fold test of folded_corners at the triangle's apex) and puts every other
+  /// one in. Returns the number left out. Without a call every triangle is in.
+  int set_barrier_mask(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& normals);
+  /// Number of barrier triangles (both splits of each quad and every triangle face).
+  int num_barrier_triangles() const { return static_cast<int>(barrier_.size()); }
+
   /// A face corner for the fold test: particle i and its successor and predecessor in the face.
   struct Corner {
     int i = -1;
@@ -112,6 +150,8 @@ class SpringSystem {
   const std::vector<Corner>& corners() const { return corners_; }
 
  private:
+  void build_barrier(const ParticleGrid& grid);
+
   const ParticleGrid* grid_ = nullptr;
   SpringEnergyOptions options_;
   int num_particles_ = 0;
@@ -120,6 +160,20 @@ class SpringSystem {
   std::vector<int> spring_offset_, spring_entry_;
   std::vector<int> angular_offset_, angular_entry_;
   std::vector<Corner> corners_;
+  // One triangle of the barrier: apex i, then next and prev in the face's order
+  // (counter-clockwise), the weight w A_s, and the source metric: B = (S^T S)^-1 (b00, b01, b11)
+  // and det(S^T S).
+  struct BarrierTriangle {
+    int i = -1, next = -1, prev = -1;
+    double weight = 0.0;
+    double b00 = 0.0, b01 = 0.0, b11 = 0.0;
+    double source_det = 0.0;
+  };
+  std::vector<BarrierTriangle> barrier_;
+  std::vector<char> barrier_active_;
+  std::vector<int> barrier_offset_,
+      barrier_entry_;                       // code 3 * triangle + role (0 i, 1 next, 2 prev)
+  mutable Eigen::Matrix3Xd barrier_force_;  // 3 columns per triangle: dE/dx of i, next, prev
   mutable Eigen::Matrix3Xd spring_force_;   // per spring: dE/dx_j
   mutable Eigen::Matrix3Xd angular_force_;  // per angular spring: dE/dx_i
 };

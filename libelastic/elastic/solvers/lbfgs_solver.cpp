@@ -31,6 +31,8 @@ constexpr int kMaxBlockRounds = 8;
 constexpr int kMaxReleases = 1;
 // Consecutive steps without an energy change beyond round-off before the solver gives up.
 constexpr int kMaxStalled = 20;
+// Longest first trial step of a particle, in mean rest lengths (times sigma).
+constexpr double kMaxStep = 2.0;
 
 // Vector kernels over [0, n) in fixed chunks. Reductions join the chunks' partial sums in a fixed
 // tree (parallel_deterministic_reduce), so every result is the same for any number of threads; at
@@ -190,6 +192,7 @@ RelaxationResult relax_lbfgs(const RelaxationProblem& problem, const RelaxationO
 
   std::vector<char> folded;
   setup.springs.folded_corners(setup.positions, setup.normals, folded);
+  const bool with_barrier = setup.springs.options().barrier_stiffness > 0.0;
 
   // Round-off of an energy evaluation. Each term C (|d| - k)^2 carries an error of about
   // 2 C |e| delta, e = |d| - k, delta the error of |d|: a few ulps of the coordinates, i.e.
@@ -220,7 +223,11 @@ RelaxationResult relax_lbfgs(const RelaxationProblem& problem, const RelaxationO
   }
   layout.tangential(gradient, setup.normals, q);
   double q_norm = std::sqrt(dot(q, q));
-  const double initial_norm = q_norm;
+  // The relative stopping test is scaled by the springs' own initial gradient: near-collapsed
+  // triangles of the start can make the barrier's share of the first gradient orders of magnitude
+  // larger, and a tolerance relative to that would stop far from the minimum.
+  const double spring_norm = with_barrier ? solver_detail::spring_gradient_norm(setup) : q_norm;
+  const double initial_norm = spring_norm > 0.0 ? spring_norm : q_norm;
   result.setup_seconds = solver_detail::seconds_since(start);
   const long long solve_start = solver_detail::now_ticks();
 
@@ -292,8 +299,13 @@ RelaxationResult relax_lbfgs(const RelaxationProblem& problem, const RelaxationO
         q_free = q;
       }
     }
+    // At the energy's round-off floor no step can be told from another by the energy: stopped
+    // there with a small gradient the map is at its minimum to working precision (the barrier's
+    // stiffness can keep the last digits of the gradient from 1e-6 while the energy no longer
+    // changes in its 13th digit).
+    const bool at_round_off = q_norm <= options.round_off_gradient_tolerance * initial_norm;
     if (stalled >= kMaxStalled) {
-      result.reason = StopReason::LineSearchFailed;
+      result.reason = at_round_off ? StopReason::RoundOff : StopReason::LineSearchFailed;
       break;
     }
     if (iteration >= max_iterations) {
@@ -371,7 +383,26 @@ RelaxationResult relax_lbfgs(const RelaxationProblem& problem, const RelaxationO
     };
     bool accepted = false;
     bool trial_q_ready = false;
+    // The first trial moves no particle farther than kMaxStep rest lengths: a step far beyond
+    // the grid's own scale (the barrier's gradient near a collapsing triangle can be orders of
+    // magnitude above the springs') would only be halved back, after walking every particle
+    // across many ptex faces for each halving.
     double alpha = 1.0;
+    {
+      const double longest = std::sqrt(tbb::parallel_deterministic_reduce(
+          tbb::blocked_range<Eigen::Index>(0, n, kChunk), 0.0,
+          [&](const tbb::blocked_range<Eigen::Index>& r, double best) {
+            for (Eigen::Index k = r.begin(); k != r.end(); ++k) {
+              best = std::max(best, layout.at(direction, k).squaredNorm());
+            }
+            return best;
+          },
+          [](double a, double b) { return std::max(a, b); }));
+      const double cap = kMaxStep * setup.mean_rest;
+      if (longest > cap && cap > 0.0) {
+        alpha = cap / longest;
+      }
+    }
     SpringEnergies trial_energies;
     int backtracks = 0, block_rounds = 0, fold_halvings = 0;
     while (backtracks < lb.max_backtracks && slope < 0.0) {
@@ -379,7 +410,10 @@ RelaxationResult relax_lbfgs(const RelaxationProblem& problem, const RelaxationO
       retract(alpha);
       setup.springs.folded_corners(trial_positions, trial_normals, trial_folded);
       // A first few folding trials only shorten the step; then the folding particles are blocked.
-      const bool block_now = fold_halvings >= kFoldHalvings && block_rounds < kMaxBlockRounds;
+      // With the injectivity barrier (EnergyKind::Robust) a short enough step never folds (the
+      // energy grows without bound first), so folding trials are only shortened, never blocked.
+      const bool block_now =
+          !with_barrier && fold_halvings >= kFoldHalvings && block_rounds < kMaxBlockRounds;
       bool new_fold = false;
       for (std::size_t c = 0; c < folded.size(); ++c) {
         if (!trial_folded[c] || folded[c]) {
@@ -451,7 +485,7 @@ RelaxationResult relax_lbfgs(const RelaxationProblem& problem, const RelaxationO
         memory.clear();
         continue;
       }
-      result.reason = StopReason::LineSearchFailed;
+      result.reason = at_round_off ? StopReason::RoundOff : StopReason::LineSearchFailed;
       break;
     }
 

@@ -52,6 +52,8 @@ std::string_view to_string(StopReason reason) {
       return "relative tangential gradient below tolerance";
     case StopReason::AbsoluteGradient:
       return "tangential gradient below the absolute bound";
+    case StopReason::RoundOff:
+      return "energy at its round-off floor with a small tangential gradient";
     case StopReason::NoFreeParticles:
       return "no interior particles";
     case StopReason::MaxIterations:
@@ -68,11 +70,27 @@ std::string_view to_string(StopReason reason) {
   return "unknown";
 }
 
+std::string_view to_string(EnergyKind kind) {
+  return kind == EnergyKind::Robust ? "robust" : "paper";
+}
+
+EnergyKind parse_energy_kind(std::string_view text, std::string_view input) {
+  if (text == "robust") {
+    return EnergyKind::Robust;
+  }
+  if (text == "paper") {
+    return EnergyKind::Paper;
+  }
+  throw InvalidInputError(std::string(input),
+                          "unknown energy '" + std::string(text) + "' (expected robust or paper)");
+}
+
 namespace {
 
-// Fast mode, and when it stops against its no-fold constraint, the explicit integrator from its
-// result (see RelaxationOptions::untangle_steps).
-RelaxationResult relax_fast(const RelaxationProblem& problem, const RelaxationOptions& options) {
+// Fast mode with the paper's energy, and when it stops against its no-fold constraint, the
+// explicit integrator from its result (see RelaxationOptions::untangle_steps).
+RelaxationResult relax_fast_paper(const RelaxationProblem& problem,
+                                  const RelaxationOptions& options) {
   RelaxationResult fast = relax_lbfgs(problem, options);
   if (fast.reason != StopReason::FoldConstrained || options.untangle_steps <= 0) {
     return fast;
@@ -110,6 +128,44 @@ RelaxationResult relax_fast(const RelaxationProblem& problem, const RelaxationOp
   fast.converged = true;
   fast.untangled = true;
   return fast;
+}
+
+// Fast mode with the robust energy. The barrier keeps every triangle that starts unfolded away
+// from collapse, but it cannot be crossed, so a start with folded faces (the naive map folds a few
+// under extreme compression) is first untangled with the paper's energy (relax_fast_paper), and
+// the barrier run starts again from that fold-free state.
+RelaxationResult relax_fast(const RelaxationProblem& problem, const RelaxationOptions& options) {
+  if (options.energy == EnergyKind::Paper) {
+    return relax_fast_paper(problem, options);
+  }
+  RelaxationResult robust = relax_lbfgs(problem, options);
+  if (robust.folded_faces == 0 || robust.reason == StopReason::Cancelled) {
+    return robust;
+  }
+  RelaxationOptions paper_options = options;
+  paper_options.energy = EnergyKind::Paper;
+  paper_options.frame = nullptr;
+  const RelaxationResult paper = relax_fast_paper(problem, paper_options);
+  if (paper.folded_faces > 0) {
+    robust.untangle_phases = 1;
+    robust.untangle_steps = paper.untangle_steps;
+    return robust;  // nothing fold-free to start the barrier from
+  }
+  RelaxationProblem again = problem;
+  again.initial_positions = paper.positions;
+  again.initial_points = paper.points;
+  RelaxationResult result = relax_lbfgs(again, options);
+  result.initial_energy = robust.initial_energy;
+  result.initial_folded_faces = robust.initial_folded_faces;
+  result.initial_gradient_norm = robust.initial_gradient_norm;
+  result.iterations += robust.iterations + paper.iterations;
+  result.evaluations += robust.evaluations + paper.evaluations;
+  result.setup_seconds += robust.setup_seconds + paper.setup_seconds;
+  result.solve_seconds += robust.solve_seconds + paper.solve_seconds;
+  result.untangle_steps = paper.untangle_steps;
+  result.untangled = paper.untangled;
+  result.untangle_phases = 1;
+  return result;
 }
 
 }  // namespace

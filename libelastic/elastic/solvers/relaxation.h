@@ -48,6 +48,9 @@ SolverKind parse_solver_kind(std::string_view text, std::string_view input = "so
 enum class StopReason {
   RelativeGradient,  ///< converged: |P g| <= relative tolerance * initial |P g|
   AbsoluteGradient,  ///< converged: |P g| below the scale-free absolute bound
+  /// converged to working precision (L-BFGS): no step changes the energy beyond its round-off
+  /// floor and |P g| <= RelaxationOptions::round_off_gradient_tolerance * initial |P g|
+  RoundOff,
   NoFreeParticles,   ///< converged trivially: every particle is on the boundary
   MaxIterations,     ///< not converged: the iteration budget ran out
   LineSearchFailed,  ///< not converged: no fold-free step decreases the energy (L-BFGS)
@@ -62,7 +65,7 @@ std::string_view to_string(StopReason reason);
 /// True for the reasons that mean convergence.
 inline bool is_converged(StopReason reason) {
   return reason == StopReason::RelativeGradient || reason == StopReason::AbsoluteGradient ||
-         reason == StopReason::NoFreeParticles;
+         reason == StopReason::RoundOff || reason == StopReason::NoFreeParticles;
 }
 
 /// One configuration handed to the frame callback.
@@ -113,15 +116,39 @@ struct LbfgsOptions {
   MultigridOptions multigrid;  ///< the V-cycle's parameters (Preconditioner::Multigrid)
 };
 
+/// Which energy the relaxation minimises.
+enum class EnergyKind {
+  /// E_len + E_ang + the injectivity barrier E_bar (particles/spring_energy.h): the paper's
+  /// minimum wherever no triangle comes close to collapse, and no slivers or folds where the
+  /// paper's energy would buckle (compressed or stretched regions). The default.
+  Robust,
+  /// The paper's E_len + E_ang alone (eqs. 13-14, §4.1): reproduces Table 1 as published.
+  Paper
+};
+/// "robust", "paper".
+std::string_view to_string(EnergyKind kind);
+/// Parses "robust" or "paper". \throws InvalidInputError naming `input` otherwise.
+EnergyKind parse_energy_kind(std::string_view text, std::string_view input = "energy");
+
 struct RelaxationOptions {
   SolverKind solver = SolverKind::Fast;  ///< which solver
-  double stiffness = 1.0;                ///< C of the normal springs (eq. 13)
-  double angular_stiffness = 1.0;        ///< C_a of the angular springs
+  /// The energy. The barrier of EnergyKind::Robust is used by the fast solver; the faithful
+  /// solver (the paper's explicit integrator) always integrates the paper's forces.
+  EnergyKind energy = EnergyKind::Robust;
+  /// mu of the barrier relative to C (SpringEnergyOptions::barrier_stiffness); Robust only.
+  double barrier_stiffness = 1.0;
+  /// Smaller stretch below which the barrier acts (SpringEnergyOptions::barrier_sigma).
+  double barrier_sigma = 0.4;
+  double stiffness = 1.0;          ///< C of the normal springs (eq. 13)
+  double angular_stiffness = 1.0;  ///< C_a of the angular springs
   /// Iteration (L-BFGS) or time-step (explicit) budget; 0: 2,000 for L-BFGS, 200,000 for explicit.
   long max_iterations = 0;
   double relative_gradient_tolerance = 1e-6;  ///< stop when |P g| <= this * initial |P g|
   /// ... or when |P g| <= this * C_max * sigma * mean_rest * sqrt(#P) (scale-free absolute bound)
   double absolute_gradient_tolerance = 1e-10;
+  /// L-BFGS: when the energy no longer changes beyond its round-off floor, the stop counts as
+  /// converged (StopReason::RoundOff) if |P g| <= this * initial |P g|.
+  double round_off_gradient_tolerance = 1e-4;
   int threads = 0;            ///< TBB threads; 0: all available
   ProgressCallback progress;  ///< called every iteration (L-BFGS) / check (explicit)
   FrameCallback frame;        ///< called every `frame_interval` iterations
@@ -139,12 +166,12 @@ struct RelaxationOptions {
 
 /// The input: a particle grid, the target surface, and the starting placement on it.
 struct RelaxationProblem {
-  const ParticleGrid* grid = nullptr;        ///< springs built; must outlive the call
-  const SurfaceProjector* target = nullptr;  ///< the target limit surface's magnet
-  Eigen::Matrix3Xd initial_positions;        ///< 3 x #P start positions on the target surface
-  std::vector<SurfacePoint> initial_points;  ///< #P their surface points
-  double rest_scale = 1.0;                   ///< sigma (rest_scale_factor)
-  RestScale rest_scale_mode = RestScale::Boundary;  ///< how sigma was chosen (echoed in the result)
+  const ParticleGrid* grid = nullptr;           ///< springs built; must outlive the call
+  const SurfaceProjector* target = nullptr;     ///< the target limit surface's magnet
+  Eigen::Matrix3Xd initial_positions;           ///< 3 x #P start positions on the target surface
+  std::vector<SurfacePoint> initial_points;     ///< #P their surface points
+  double rest_scale = 1.0;                      ///< sigma (rest_scale_factor)
+  RestScale rest_scale_mode = RestScale::Auto;  ///< how sigma was chosen (echoed in the result)
   /// 3 x boundary_loop.size(): where each boundary particle belongs on the target curve (its
   /// arc-length position). Optional: when empty, the boundary residual is measured against
   /// initial_positions.
@@ -163,13 +190,18 @@ struct RelaxationResult {
   Preconditioner preconditioner = Preconditioner::Multigrid;
   double setup_seconds =
       0.0;  ///< incidence tables, Laplacian and its H0 (multigrid or factor), normals
-  double solve_seconds = 0.0;   ///< the iterations
-  double initial_energy = 0.0;  ///< E_len + E_ang at the start
-  double length_energy = 0.0;   ///< final E_len (eq. 13)
-  double angular_energy = 0.0;  ///< final E_ang
-  double magnet_energy = 0.0;   ///< explicit: magnet energy of the last integrator state before the
-                                ///< final projection; L-BFGS: 0 (particles stay on the surface)
-  double gradient_norm = 0.0;   ///< final |P g|
+  double solve_seconds = 0.0;              ///< the iterations
+  double initial_energy = 0.0;             ///< E_len + E_ang at the start
+  double length_energy = 0.0;              ///< final E_len (eq. 13)
+  double angular_energy = 0.0;             ///< final E_ang
+  double barrier_energy = 0.0;             ///< final E_bar (0 with EnergyKind::Paper)
+  EnergyKind energy = EnergyKind::Robust;  ///< the energy minimised (Paper for the faithful solver)
+  /// Robust energy: runs of the paper's energy (with untangling) that were needed first because
+  /// the start (or a fold-constrained stop) had folded faces, which the barrier cannot cross.
+  int untangle_phases = 0;
+  double magnet_energy = 0.0;  ///< explicit: magnet energy of the last integrator state before the
+                               ///< final projection; L-BFGS: 0 (particles stay on the surface)
+  double gradient_norm = 0.0;  ///< final |P g|
   double initial_gradient_norm = 0.0;  ///< initial |P g|
   /// gradient_norm / initial_gradient_norm (0 when the latter is 0)
   double relative_gradient = 0.0;
@@ -184,7 +216,7 @@ struct RelaxationResult {
   bool untangled = false;
   double boundary_residual = 0.0;  ///< max distance of a boundary particle from its target position
   double rest_scale = 1.0;         ///< sigma used
-  RestScale rest_scale_mode = RestScale::Boundary;  ///< its mode, as given
+  RestScale rest_scale_mode = RestScale::Auto;  ///< its mode, as given
   // Explicit integrator parameters actually used (0 for L-BFGS).
   double time_step = 0.0;         ///< dt
   double damping = 0.0;           ///< gamma

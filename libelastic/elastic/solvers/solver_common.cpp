@@ -32,9 +32,12 @@ const ParticleGrid& checked_grid(const RelaxationProblem& problem) {
 
 SpringEnergyOptions energy_options(const RelaxationProblem& problem,
                                    const RelaxationOptions& options) {
+  const bool barrier = options.energy == EnergyKind::Robust && options.solver == SolverKind::Fast;
   return {.stiffness = options.stiffness,
           .angular_stiffness = options.angular_stiffness,
-          .rest_scale = problem.rest_scale};
+          .rest_scale = problem.rest_scale,
+          .barrier_stiffness = barrier ? options.barrier_stiffness : 0.0,
+          .barrier_sigma = options.barrier_sigma};
 }
 
 }  // namespace
@@ -111,6 +114,10 @@ RelaxationSetup::RelaxationSetup(const RelaxationProblem& problem, const Relaxat
                         }
                       }
                     });
+
+  // Triangles folded at the start stay out of the barrier (it cannot be crossed: they could only
+  // be held folded). The fold guard still keeps them from folding again once they unfold.
+  springs.set_barrier_mask(positions, normals);
 
   double sum = 0.0;
   for (const Spring& s : grid.springs) {
@@ -608,6 +615,14 @@ double boundary_residual(const RelaxationProblem& problem, const Eigen::Matrix3X
   return residual;
 }
 
+double spring_gradient_norm(const RelaxationSetup& setup) {
+  SpringEnergyOptions paper = setup.springs.options();
+  paper.barrier_stiffness = 0.0;
+  Eigen::Matrix3Xd gradient;
+  SpringSystem(setup.grid, paper).evaluate(setup.positions, &gradient);
+  return tangential_norm(setup, gradient, setup.normals);
+}
+
 void finish_result(const RelaxationSetup& setup, const RelaxationProblem& problem,
                    double initial_gradient_norm, RelaxationResult& result) {
   Eigen::Matrix3Xd gradient;
@@ -616,6 +631,9 @@ void finish_result(const RelaxationSetup& setup, const RelaxationProblem& proble
   result.points = setup.points;
   result.length_energy = energies.length;
   result.angular_energy = energies.angular;
+  result.barrier_energy = energies.barrier;
+  result.energy =
+      setup.springs.options().barrier_stiffness > 0.0 ? EnergyKind::Robust : EnergyKind::Paper;
   result.initial_gradient_norm = initial_gradient_norm;
   result.gradient_norm = tangential_norm(setup, gradient, setup.normals);
   result.relative_gradient =

@@ -42,6 +42,9 @@ struct RelaxationSetup {
 double tangential_norm(const RelaxationSetup& setup, const Eigen::Matrix3Xd& gradient,
                        const Eigen::Matrix3Xd& normals);
 
+/// tangential_norm of the gradient of E_len + E_ang alone (no barrier) at the setup's positions.
+double spring_gradient_norm(const RelaxationSetup& setup);
+
 /// The spring-graph Laplacian restricted to the interior particles (n x n, n = num_free()): 2C per
 /// normal spring, and for each angular spring the Gram matrix 2 C_a v v^T with v = (1, -1/2, -1/2)
 /// on (i, a, b), which is the angular energy's Hessian with the unit-direction factor e e^T/|e|^2
