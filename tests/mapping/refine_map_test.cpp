@@ -129,7 +129,9 @@ TEST(RefineMap, PlaneOntoCapKeepsZeroFoldsAndBoundedEnergy) {
   // c^2 / (8 R) for a chord of length c on a boundary of curvature radius R >= c: below c / 8.
   const SurfaceCurve curve = c.to.boundary_curve();
   for (size_t k = 1; k < grid.boundary_loop.size(); k += 2) {
-    const SurfaceCurve::Location at = curve.locate(grid.boundary_parameter[k]);
+    // (at the correspondence the map chose: turned by its boundary offset)
+    const SurfaceCurve::Location at =
+        curve.locate(grid.boundary_parameter[k] + coarse.boundary_offset);
     const double chord =
         (curve.positions[(at.segment + 1) % curve.size()] - curve.positions[at.segment]).norm();
     EXPECT_LT((r.positions.col(grid.boundary_loop[k]) - at.position).norm(), chord / 8) << k;

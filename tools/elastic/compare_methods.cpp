@@ -58,6 +58,7 @@ std::vector<MethodMeasurement> compare_methods(const MapSession& session,
     const std::string name(to_string(kind));
     try {
       BaselineOptions baseline_options;
+      baseline_options.target_offset = session.result.boundary_offset;
       baseline_options.kind = kind;
       const BaselineResult b =
           map_baseline(grid, *session.source.projector, session.source_region,

@@ -73,8 +73,17 @@ void add_map_flags(CLI::App& sub, MapJob& a) {
   sub.add_option("--preconditioner", a.preconditioner,
                  "H0 of lbfgs: multigrid (V-cycle, default) or direct (exact factorisation)")
       ->check(CLI::IsMember({"multigrid", "direct"}));
-  sub.add_option("--rest-scale", a.rest_scale, "boundary | area | none")
-      ->check(CLI::IsMember({"boundary", "area", "none"}));
+  sub.add_option("--rest-scale", a.rest_scale,
+                 "auto (default: the smaller of boundary and area) | boundary | area | none")
+      ->check(CLI::IsMember({"auto", "boundary", "area", "none"}));
+  sub.add_option("--boundary-offset", a.boundary_offset,
+                 "auto (default: turn the correspondence to the least naive-map energy when no "
+                 "anchor is given) or anchor (start at the regions' anchors)")
+      ->check(CLI::IsMember({"auto", "anchor"}));
+  sub.add_option("--energy", a.energy,
+                 "robust (default: the paper's springs plus an injectivity barrier) or paper "
+                 "(the paper's springs alone, as in Table 1)")
+      ->check(CLI::IsMember({"robust", "paper"}));
   sub.add_option("--scheme", a.scheme, "Subdivision scheme for both meshes")
       ->check(CLI::IsMember({"auto", "loop", "catmull-clark"}));
   sub.add_option("--subdivide", a.subdivide,
@@ -95,6 +104,8 @@ MapOptions make_map_options(const MapJob& job, const ProgressCallback& progress)
   options.sampling.sampling.seed = job.seed;
   options.rest_scale = parse_rest_scale(job.rest_scale, "--rest-scale");
   options.relaxation.solver = job.solver == "explicit" ? SolverKind::Faithful : SolverKind::Fast;
+  options.relaxation.energy = parse_energy_kind(job.energy, "--energy");
+  options.choose_offset = job.boundary_offset == "auto";
   options.relaxation.lbfgs.preconditioner =
       parse_preconditioner(job.preconditioner, "--preconditioner");
   options.relaxation.threads = job.threads;
@@ -185,9 +196,11 @@ nlohmann::json map_report(const MapJob& job, const MapSession& session,
             {"naive_map", r.seconds_naive},
             {"solver_setup", x.setup_seconds},
             {"mapping", r.seconds_mapping}}},
+          {"energy_kind", std::string(to_string(x.energy))},
           {"energy",
            {{"length", x.length_energy},
             {"angle", x.angular_energy},
+            {"barrier", x.barrier_energy},
             {"magnet", x.magnet_energy},
             {"initial", x.initial_energy}}},
           {"gradient", {{"relative", x.relative_gradient}, {"norm", x.gradient_norm}}},
@@ -197,6 +210,11 @@ nlohmann::json map_report(const MapJob& job, const MapSession& session,
           {"initial_folds", x.initial_folded_faces},
           {"boundary_residual", x.boundary_residual},
           {"rest_scale", {{"mode", job.rest_scale}, {"factor", r.rest_scale}}},
+          {"boundary_offset",
+           {{"chosen", r.offset_chosen},
+            {"offset", r.boundary_offset},
+            {"naive_energy", r.offset_energy},
+            {"naive_energy_at_zero", r.offset_energy_at_zero}}},
           {"subdivision", subdivision_report(r)},
           {"sampling",
            {{"spacing_min", s.spacing_min},

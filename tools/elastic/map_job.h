@@ -35,7 +35,9 @@ struct MapJob {
   long particles = 1000;                     ///< --particles N
   std::string solver = "lbfgs";              ///< --solver lbfgs|explicit
   std::string preconditioner = "multigrid";  ///< --preconditioner multigrid|direct (lbfgs)
-  std::string rest_scale = "boundary";       ///< --rest-scale boundary|area|none
+  std::string rest_scale = "auto";           ///< --rest-scale auto|boundary|area|none
+  std::string energy = "robust";             ///< --energy robust|paper
+  std::string boundary_offset = "auto";      ///< --boundary-offset auto|anchor
   std::string scheme = "auto";               ///< --scheme auto|loop|catmull-clark
   int subdivide = 0;                         ///< --subdivide K: refinement levels after the map
   int threads = 0;                           ///< --threads N (0: all)

@@ -180,8 +180,10 @@ class RegionPointLocator {
 // the same point in a flattening (linear along the flattened boundary edge).
 class BoundaryParametrisation {
  public:
-  BoundaryParametrisation(const Region& region, const std::string& name)
-      : region_(&region), curve_(region.boundary_curve()) {
+  // `offset` turns the correspondence: parameter s means the curve point at s + offset from the
+  // region's anchor (RegionDiskMap::set_offset, BaselineOptions::target_offset).
+  BoundaryParametrisation(const Region& region, const std::string& name, double offset = 0.0)
+      : region_(&region), curve_(region.boundary_curve()), offset_(offset) {
     cumulative_ = curve_.arc_lengths();
     total_ = curve_.length();
     if (!(total_ > 0.0)) {
@@ -210,7 +212,10 @@ class BoundaryParametrisation {
     }
   }
 
-  SurfaceCurve::Location locate(double s) const { return curve_.locate(s, cumulative_, total_); }
+  SurfaceCurve::Location locate(double s) const {
+    const double turned = s + offset_;
+    return curve_.locate(turned - std::floor(turned), cumulative_, total_);
+  }
 
   /// The surface point at parameter s (on the boundary edge of its triangle).
   SurfacePoint point(double s) const {
@@ -234,6 +239,7 @@ class BoundaryParametrisation {
  private:
   const Region* region_;
   SurfaceCurve curve_;
+  double offset_ = 0.0;
   std::vector<double> cumulative_;
   double total_ = 0.0;
   std::vector<int> edge_triangle_;
@@ -325,7 +331,8 @@ BaselineResult map_baseline(const ParticleGrid& grid, const SurfaceProjector& so
   //    (Umeyama 1991 in complex form: b matches the centroids, a = <p', q'> / |p'|^2 on the
   //    centred samples).
   const BoundaryParametrisation source_boundary(source_region, "source region");
-  const BoundaryParametrisation target_boundary(target_region, "target region");
+  const BoundaryParametrisation target_boundary(target_region, "target region",
+                                                options.target_offset);
   const int samples = options.alignment_samples;
   std::vector<Complex> p(static_cast<size_t>(samples)), q(static_cast<size_t>(samples));
   Complex p_mean = 0.0, q_mean = 0.0;

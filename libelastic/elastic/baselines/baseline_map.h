@@ -57,6 +57,9 @@ struct BaselineOptions {
   /// regions are refused (NumericalError: the method cannot run on this valid input) instead of
   /// hanging; coarsen the projector's tessellation or raise this.
   int arap_max_vertices = 50000;
+  /// Turn of the boundary correspondence on the target (MapResult::boundary_offset): source
+  /// parameter s corresponds to target parameter s + target_offset, as in ElasticPaint's map.
+  double target_offset = 0.0;
   /// Common correspondence parameters s = i / n sampled on both boundaries to fit the alignment.
   int alignment_samples = 2048;
   /// Barycentric tolerance of point location in the flattenings (relative to a triangle: 1e-9 is

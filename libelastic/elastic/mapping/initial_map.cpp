@@ -144,6 +144,7 @@ bool RegionDiskMap::to_disk(const SurfacePoint& p, Eigen::Vector2d& disk) const 
     }
     if (best >= 0) {
       interpolate(best, best_w.cwiseMax(0.0) / best_w.cwiseMax(0.0).sum());
+      disk = turn_.transpose() * disk;
       return true;
     }
   }
@@ -175,6 +176,7 @@ bool RegionDiskMap::to_disk(const SurfacePoint& p, Eigen::Vector2d& disk) const 
     return false;
   }
   interpolate(best, best_w);
+  disk = turn_.transpose() * disk;
   return true;
 }
 
@@ -183,9 +185,10 @@ bool RegionDiskMap::from_disk(const Eigen::Vector2d& disk, SurfacePoint& p,
   if (!disk.allFinite() || disk.norm() > 1.0 + tolerance) {
     return false;
   }
-  TriangleLocator2D::Hit hit = locators_->disk.locate(disk, 1e-12);
+  const Eigen::Vector2d flat = turn_ * disk;
+  TriangleLocator2D::Hit hit = locators_->disk.locate(flat, 1e-12);
   if (!hit.found()) {
-    hit = locators_->disk.nearest(disk);  // between the circle and its inscribed polygon
+    hit = locators_->disk.nearest(flat);  // between the circle and its inscribed polygon
   }
   if (!hit.found()) {
     return false;
@@ -198,7 +201,7 @@ SurfacePoint RegionDiskMap::boundary_point(double s) const {
   const Region& region = *region_;
   const std::vector<double>& arc = locators_->boundary_arc;
   const int n = static_cast<int>(region.boundary.size());
-  double a = std::fmod(region.anchor + s, 1.0);
+  double a = std::fmod(region.anchor + offset_ + s, 1.0);
   if (a < 0.0) {
     a += 1.0;
   }
@@ -211,6 +214,12 @@ SurfacePoint RegionDiskMap::boundary_point(double s) const {
   w[locators_->boundary_corners[k][0]] = 1.0 - t;
   w[locators_->boundary_corners[k][1]] = t;
   return region.point_in_triangle(locators_->boundary_triangle[k], w[1], w[2]);
+}
+
+void RegionDiskMap::set_offset(double offset) {
+  offset_ = offset - std::floor(offset);
+  const double angle = 2.0 * std::numbers::pi * offset_;
+  turn_ << std::cos(angle), -std::sin(angle), std::sin(angle), std::cos(angle);
 }
 
 InitialMap naive_map(const ParticleGrid& grid, const RegionDiskMap& source,
@@ -242,6 +251,39 @@ InitialMap naive_map(const ParticleGrid& grid, const RegionDiskMap& source,
     result.points[i] = q;
     result.positions.col(i) = surface.position(q);
   }
+  return result;
+}
+
+}  // namespace elastic
+
+namespace elastic {
+
+BoundaryOffsetResult choose_boundary_offset(const ParticleGrid& grid, const RegionDiskMap& source,
+                                            RegionDiskMap& target,
+                                            const BoundaryOffsetOptions& options) {
+  if (options.candidates < 1) {
+    throw InvalidInputError("boundary offset", "needs at least one candidate");
+  }
+  const SpringSystem springs(grid, options.energy);
+  BoundaryOffsetResult result;
+  result.candidates = options.candidates;
+  double best = std::numeric_limits<double>::infinity();
+  for (int k = 0; k < options.candidates; ++k) {
+    const double offset = static_cast<double>(k) / options.candidates;
+    target.set_offset(offset);
+    const InitialMap naive = naive_map(grid, source, target);
+    const double energy = naive.outside > 0 ? std::numeric_limits<double>::infinity()
+                                            : springs.evaluate(naive.positions).total();
+    if (k == 0) {
+      result.energy_at_zero = energy;
+    }
+    if (energy < best) {  // ties keep the smaller offset (the region's own anchor first)
+      best = energy;
+      result.offset = offset;
+    }
+  }
+  result.energy = best;
+  target.set_offset(result.offset);
   return result;
 }
 

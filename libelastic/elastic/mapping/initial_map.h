@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "elastic/particles/particle_grid.h"
+#include "elastic/particles/spring_energy.h"
 #include "elastic/regions/region.h"
 #include "elastic/regions/region_flattening.h"
 
@@ -39,8 +40,17 @@ class RegionDiskMap {
   /// The point of the boundary curve at correspondence parameter s (angle 2 pi s on the disk).
   SurfacePoint boundary_point(double s) const;
 
+  /// Turns the correspondence by `offset` (a fraction of the boundary, in [0, 1)): parameter s
+  /// then means the curve point at s + offset from the region's anchor, and disk coordinates turn
+  /// with it (by 2 pi offset), so the three queries above stay one consistent bijection.
+  void set_offset(double offset);
+  double offset() const { return offset_; }
+
  private:
   const Region* region_ = nullptr;
+  double offset_ = 0.0;
+  Eigen::Matrix2d turn_ =
+      Eigen::Matrix2d::Identity();  // flattening coordinates of disk point z: turn_ z
   RegionFlattening flattening_;
   struct Locators;
   std::shared_ptr<const Locators> locators_;
@@ -57,5 +67,29 @@ struct InitialMap {
 /// \throws NumericalError when a disk map cannot be built.
 InitialMap naive_map(const ParticleGrid& grid, const RegionDiskMap& source,
                      const RegionDiskMap& target);
+
+struct BoundaryOffsetOptions {
+  /// Offsets tried: k / candidates of the boundary, k = 0 .. candidates - 1.
+  int candidates = 24;
+  /// The energy that judges a naive map (the paper's E_len + E_ang at the relaxation's sigma).
+  SpringEnergyOptions energy;
+};
+
+struct BoundaryOffsetResult {
+  double offset = 0.0;          ///< the chosen offset, as set on the target disk map
+  double energy = 0.0;          ///< E_len + E_ang of the naive map with that offset
+  double energy_at_zero = 0.0;  ///< the same with the region's own anchor (offset 0)
+  int candidates = 0;           ///< offsets tried
+};
+
+/// Chooses where the boundary correspondence starts on the target (when no anchor says so): the
+/// offset among `candidates` equally spaced ones whose naive map has the least paper energy, set on
+/// `target` (RegionDiskMap::set_offset). A rotation of the correspondence the user did not ask
+/// for costs nothing, and a bad one (a rectangle's corners landing where the target curve bends,
+/// a shape turned against the target's) forces distortion that no relaxation with a fixed boundary
+/// can remove.
+BoundaryOffsetResult choose_boundary_offset(const ParticleGrid& grid, const RegionDiskMap& source,
+                                            RegionDiskMap& target,
+                                            const BoundaryOffsetOptions& options = {});
 
 }  // namespace elastic

@@ -43,12 +43,6 @@ MapResult map_regions(const SurfaceProjector& source, const Region& source_regio
   start = std::chrono::steady_clock::now();
   result.source_disk = std::make_unique<RegionDiskMap>(source_region);
   result.target_disk = std::make_unique<RegionDiskMap>(target_region);
-  result.naive = naive_map(grid, *result.source_disk, *result.target_disk);
-  if (result.naive.outside > 0) {
-    throw NumericalError("map", std::to_string(result.naive.outside) +
-                                    " particles could not be placed in the target region");
-  }
-  result.seconds_naive = seconds_since(start);
 
   // 3. Rest scale sigma between the two regions' sizes.
   const RegionSizes sizes{.source_boundary_length = source_region.boundary_curve().length(),
@@ -56,6 +50,25 @@ MapResult map_regions(const SurfaceProjector& source, const Region& source_regio
                           .source_area = source_region.area(),
                           .target_area = target_region.area()};
   result.rest_scale = rest_scale_factor(options.rest_scale, sizes);
+
+  if (options.choose_offset && !source_region.anchor_given && !target_region.anchor_given) {
+    const BoundaryOffsetResult offset = choose_boundary_offset(
+        grid, *result.source_disk, *result.target_disk,
+        {.candidates = options.offset_candidates,
+         .energy = {.stiffness = options.relaxation.stiffness,
+                    .angular_stiffness = options.relaxation.angular_stiffness,
+                    .rest_scale = result.rest_scale}});
+    result.boundary_offset = offset.offset;
+    result.offset_chosen = true;
+    result.offset_energy = offset.energy;
+    result.offset_energy_at_zero = offset.energy_at_zero;
+  }
+  result.naive = naive_map(grid, *result.source_disk, *result.target_disk);
+  if (result.naive.outside > 0) {
+    throw NumericalError("map", std::to_string(result.naive.outside) +
+                                    " particles could not be placed in the target region");
+  }
+  result.seconds_naive = seconds_since(start);
 
   // 4. Relaxation on the target (§4.2, §4.4-4.6). Boundary particles stay at their arc-length
   // positions.

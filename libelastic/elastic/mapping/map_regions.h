@@ -35,7 +35,12 @@ struct MapOptions {
   /// Solver, stiffnesses, tolerances, threads, callbacks (solvers/relaxation.h).
   RelaxationOptions relaxation;
   /// How rest lengths are scaled between source and target sizes (particles/spring_energy.h).
-  RestScale rest_scale = RestScale::Boundary;
+  RestScale rest_scale = RestScale::Auto;
+  /// Choose where the boundary correspondence starts on the target (choose_boundary_offset) when
+  /// neither region's anchor was given by the user; given anchors always win.
+  bool choose_offset = true;
+  /// Offsets tried by that choice.
+  int offset_candidates = 24;
   /// Levels of 1-to-4 grid subdivision after the relaxation (end of §4.3, mapping/refine_map.h),
   /// each followed by a brief relaxation; every level multiplies the particles by about 4. 0: none.
   int subdivisions = 0;
@@ -55,8 +60,14 @@ struct MapResult {
   /// The naive map of the grid (recomputed for the refined grid after subdivision, so it has one
   /// entry per particle of sampling.grid; the relaxation started from the sampled grid's).
   InitialMap naive;
-  RelaxationResult relaxation;    ///< the relaxed placement and the solver's report
-  double rest_scale = 1.0;        ///< sigma actually used
+  RelaxationResult relaxation;  ///< the relaxed placement and the solver's report
+  double rest_scale = 1.0;      ///< sigma actually used
+  /// The turn of the boundary correspondence on the target (RegionDiskMap::set_offset), a
+  /// fraction of the boundary: 0 unless chosen (MapOptions::choose_offset).
+  double boundary_offset = 0.0;
+  bool offset_chosen = false;  ///< whether choose_boundary_offset ran (no anchor given)
+  /// The naive map's paper energy with the chosen offset and with offset 0 (when chosen).
+  double offset_energy = 0.0, offset_energy_at_zero = 0.0;
   double seconds_sampling = 0.0;  ///< source sampling (layout + adaptive sampling + springs)
   double seconds_naive = 0.0;     ///< disk maps of both regions + naive placement
   double seconds_mapping = 0.0;   ///< building the queryable mapping

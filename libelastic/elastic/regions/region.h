@@ -35,6 +35,9 @@ struct Region {
 
   std::vector<int> boundary;  ///< vertex indices of the boundary loop, counter-clockwise
   double anchor = 0.0;        ///< correspondence start on the boundary (see SurfaceCurve::anchor)
+  /// True when `anchor` was given by the user (RegionSpec::anchor), false when chosen
+  /// automatically; the mapping may turn an automatic correspondence (choose_boundary_offset).
+  bool anchor_given = false;
 
   int num_vertices() const { return static_cast<int>(positions.size()); }
   int num_triangles() const { return static_cast<int>(triangles.size()); }

@@ -689,6 +689,7 @@ Region make_region(const SurfaceProjector& projector, const RegionSpec& spec,
       throw InvalidInputError(options.name, "anchor is not finite");
     }
     region.anchor = region.boundary_curve().nearest_arc_parameter(*spec.anchor);
+    region.anchor_given = true;
   } else {
     region.anchor = automatic_anchor(region);
   }
