@@ -341,10 +341,10 @@ TEST(AssimpOutputs, TexturedSpotKeepsItsTextureInEveryOutputAfterTheFolderMoves)
   // colors.ply: outside the region, spot's texture (not a flat grey): many distinct colours.
   check_ply_against_ours(moved / "colors.ply");
   const PolygonMesh colors = read_mesh(moved / "colors.ply").mesh;
-  std::map<std::array<int, 3>, int> distinct;
+  std::map<std::array<long, 3>, int> distinct;
   for (const Eigen::Vector3f& c : colors.vertex_colors) {
-    ++distinct[{static_cast<int>(c.x() * 255.0f + 0.5f), static_cast<int>(c.y() * 255.0f + 0.5f),
-                static_cast<int>(c.z() * 255.0f + 0.5f)}];
+    ++distinct[{std::lround(c.x() * 255.0f), std::lround(c.y() * 255.0f),
+                std::lround(c.z() * 255.0f)}];
   }
   EXPECT_GT(distinct.size(), 100u) << "spot's texture is not in its vertex colours";
 

@@ -78,7 +78,10 @@ std::filesystem::path OutputFolder::copy_in(const std::filesystem::path& file) {
   const std::string stem = source.stem().string(), extension = source.extension().string();
   std::string name = source.filename().string();
   for (int k = 2; names_.count(name) > 0; ++k) {
-    name = stem + "_" + std::to_string(k) + extension;
+    name = stem;
+    name.push_back('_');
+    name.append(std::to_string(k));
+    name.append(extension);
   }
   std::ifstream in(source, std::ios::binary);
   if (!in) {
@@ -92,7 +95,7 @@ std::filesystem::path OutputFolder::copy_in(const std::filesystem::path& file) {
   if (size < 0 || !in) {
     throw IoError(file.string(), "cannot read the file to copy it into " + dir_.string());
   }
-  const std::filesystem::path destination = dir_ / name;
+  std::filesystem::path destination = dir_ / name;
   write_file_atomically(
       destination,
       [&](std::ofstream& out) {
@@ -106,7 +109,7 @@ std::filesystem::path OutputFolder::copy_in(const std::filesystem::path& file) {
 }
 
 std::filesystem::path OutputFolder::write_image(const std::string& name, const Image& image) {
-  const std::filesystem::path path = claim(name);
+  std::filesystem::path path = claim(name);
   write_png(path, image);
   // A later copy_in of this very file (a material naming it) references it where it is.
   copied_[canonical_or_absolute(path)] = name;
@@ -145,7 +148,7 @@ std::vector<std::filesystem::path> OutputFolder::write_obj(const std::string& na
 
 std::filesystem::path OutputFolder::write_mesh(const std::string& name, const PolygonMesh& mesh,
                                                const MeshWriteOptions& options) {
-  const std::filesystem::path path = claim(name);
+  std::filesystem::path path = claim(name);
   elastic::write_mesh(path, mesh, options);
   record(path);
   return path;

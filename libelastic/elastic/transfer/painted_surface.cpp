@@ -415,7 +415,7 @@ Eigen::Vector3f TargetColor::operator()(const SurfacePoint& p) const {
   if (m < 0) {
     return fallback_;
   }
-  const Eigen::Vector3f kd = control.materials[static_cast<size_t>(m)].diffuse.cast<float>();
+  Eigen::Vector3f kd = control.materials[static_cast<size_t>(m)].diffuse.cast<float>();
   const Image& image = images_[static_cast<size_t>(m)];
   if (image.empty()) {
     return kd;
