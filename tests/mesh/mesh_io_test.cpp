@@ -13,6 +13,7 @@
 #include <random>
 
 #include "elastic/core/error.h"
+#include "elastic/mesh/default_material.h"
 #include "support.h"
 
 namespace elastic {
@@ -128,6 +129,41 @@ TEST(MeshIo, ObjRoundTripKeepsEverything) {
   EXPECT_EQ(r.mesh.creases[0].v1, 1);
   EXPECT_EQ(r.mesh.creases[0].sharpness, 2.5);
   EXPECT_EQ(r.mesh.corners, m.corners);
+}
+
+TEST(MeshIo, ObjFacesWithoutAMaterialAreWrittenUnderTheDefinedDefault) {
+  // Faces without a material, before and after faces with one: every face is under a `usemtl`
+  // (a reader would otherwise pick a material of its own for the first ones), and the .mtl
+  // defines "default" as default_material() says.
+  const fs::path dir = test::scratch_dir("obj_default_material");
+  PolygonMesh m = awkward_mesh();
+  m.face_materials = {-1, 0, -1, 1, -1};
+  write_mesh(dir / "p.obj", m);
+  const std::string obj = read_text(dir / "p.obj");
+  const size_t first_face = obj.find("\nf ");
+  ASSERT_NE(first_face, std::string::npos);
+  EXPECT_NE(obj.rfind("usemtl default\n", first_face), std::string::npos) << obj;
+  const std::string mtl = read_text(dir / "p.mtl");
+  EXPECT_NE(mtl.find("newmtl default\nKd 0.8 0.8 0.8\n"), std::string::npos) << mtl;
+  const MeshReadResult r = read_mesh(dir / "p.obj");
+  ASSERT_EQ(r.mesh.materials.size(), 3u);
+  const Material& d = r.mesh.materials[static_cast<size_t>(r.mesh.face_materials[0])];
+  EXPECT_EQ(d.name, default_material().name);
+  EXPECT_EQ(d.diffuse, default_material().diffuse);
+  EXPECT_TRUE(d.diffuse_texture.empty());
+  EXPECT_EQ(r.mesh.face_materials[2], r.mesh.face_materials[0]);
+  EXPECT_EQ(r.mesh.face_materials[1], 0);
+
+  // assign_default_material does the same in memory, reusing a material named "default".
+  PolygonMesh n = awkward_mesh();
+  n.face_materials.clear();
+  EXPECT_EQ(assign_default_material(n), n.num_faces());
+  EXPECT_EQ(n.materials.back().name, "default");
+  EXPECT_EQ(assign_default_material(n), 0);
+  n.face_materials[0] = -1;
+  const size_t count = n.materials.size();
+  EXPECT_EQ(assign_default_material(n), 1);
+  EXPECT_EQ(n.materials.size(), count);
 }
 
 TEST(MeshIo, ObjWithoutAttributesWhenAsked) {

@@ -1,5 +1,6 @@
 // Heatmap colours: the ramp's fixed points, the automatic range against a hand-computed quantile,
-// fold and outside colours, vertex colours as averages of face colours, a PLY round trip.
+// fold and outside colours, vertex colours as ramp colours of the mean value around each vertex,
+// one shared scale for several maps, a PLY round trip.
 
 #include "elastic/metrics/heatmap.h"
 
@@ -75,10 +76,43 @@ TEST(Heatmap, FixedRangeExcludedColourAndVertexAverages) {
   options.high = 8.0;
   const HeatmapResult h = make_heatmap(positions, m, options);
   EXPECT_TRUE(h.mesh.face_colors[2].isApprox(options.excluded_color, kExact));
-  // Vertex 1 is in triangles 0 and 1 (green and red): its colour is their mean (0.5, 0.5, 0).
-  EXPECT_TRUE(h.mesh.vertex_colors[1].isApprox(Eigen::Vector3f(0.5f, 0.5f, 0.0f), 1e-6f));
-  // Vertex 0 is only in triangle 0.
+  // Vertex 1 is in triangles 0 and 1 (values 4 and 8): the ramp colour of their mean 6, yellow
+  // (a colour of the legend, not the olive (0.5, 0.5, 0) of averaged colours).
+  EXPECT_TRUE(h.mesh.vertex_colors[1].isApprox(Eigen::Vector3f(1, 1, 0), kExact));
+  // Vertex 0 is only in triangle 0; vertex 3 in triangle 1 and the excluded 2 (left out): red;
+  // vertex 4 only in the excluded triangle.
   EXPECT_TRUE(h.mesh.vertex_colors[0].isApprox(Eigen::Vector3f(0, 1, 0), kExact));
+  EXPECT_TRUE(h.mesh.vertex_colors[3].isApprox(Eigen::Vector3f(1, 0, 0), kExact));
+  EXPECT_TRUE(h.mesh.vertex_colors[4].isApprox(options.excluded_color, kExact));
+}
+
+TEST(Heatmap, VerticesOfAFoldShowTheFoldColour) {
+  Eigen::Matrix3Xd positions;
+  MapMetrics m = strip_metrics({4.0, 4.0, 4.0}, positions);
+  m.per_triangle.folded[1] = 1;
+  const HeatmapResult h = make_heatmap(positions, m);
+  for (const int p : {1, 2, 3}) {  // triangle 1's corners
+    EXPECT_TRUE(h.mesh.vertex_colors[p].isApprox(HeatmapOptions().fold_color, kExact)) << p;
+  }
+  EXPECT_TRUE(h.mesh.vertex_colors[0].isApprox(Eigen::Vector3f(0, 1, 0), kExact));
+}
+
+TEST(Heatmap, SharedScaleIsTheWorstMapsAutomaticHigh) {
+  Eigen::Matrix3Xd positions;
+  const MapMetrics good = strip_metrics({4.0, 5.0, 6.0}, positions);
+  const MapMetrics bad = strip_metrics({4.0, 10.0, 20.0}, positions);
+  HeatmapOptions options;
+  options.percentile = 1.0;  // the largest value: 6 and 20
+  EXPECT_DOUBLE_EQ(heatmap_automatic_high(good, options), 6.0);
+  const HeatmapOptions shared = shared_heatmap_scale({&good, &bad}, options);
+  EXPECT_DOUBLE_EQ(*shared.low, 4.0);
+  EXPECT_DOUBLE_EQ(*shared.high, 20.0);
+  // On the shared scale the good map's worst triangle is green-yellow, not red.
+  const HeatmapResult h = make_heatmap(positions, good, shared);
+  EXPECT_DOUBLE_EQ(h.high, 20.0);
+  EXPECT_FLOAT_EQ(h.mesh.face_colors[2].y(), 1.0f);
+  EXPECT_FLOAT_EQ(h.mesh.face_colors[2].x(), 2.0f * 2.0f / 16.0f);
+  EXPECT_THROW(shared_heatmap_scale({}), InvalidInputError);
 }
 
 TEST(Heatmap, PerfectMapIsAllGreenWithAWidenedRange) {

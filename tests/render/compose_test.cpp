@@ -1,5 +1,5 @@
-// Side-by-side pictures, contact sheets and the bitmap font: sizes from the documented layout,
-// pixels copied exactly to where the layout puts them.
+// Side-by-side pictures, contact sheets, stacks, colour legends and the bitmap font: sizes from the
+// documented layout, pixels copied exactly to where the layout puts them.
 #include "elastic/render/compose.h"
 
 #include <gtest/gtest.h>
@@ -93,6 +93,61 @@ TEST(Compose, TextHasTheDocumentedSizeAndShape) {
   draw_text(lower, 1, 1, "ab", 1, Eigen::Vector4f(0, 0, 0, 1));
   EXPECT_TRUE(upper.pixels == lower.pixels);
   EXPECT_FALSE(upper.pixels == Image(20, 9, kWhite).pixels);
+}
+
+TEST(Compose, StackCentresImagesOneAboveTheOther) {
+  ComposeOptions options;
+  options.gap = 1;
+  const Image s = stack({filled(4, 2, kRed), filled(2, 3, kBlue)}, options);
+  EXPECT_EQ(s.width, 1 + 4 + 1);
+  EXPECT_EQ(s.height, 1 + 2 + 1 + 3 + 1);
+  EXPECT_EQ(s.at(1, 1), kRed);
+  EXPECT_EQ(s.at(4, 2), kRed);
+  EXPECT_EQ(s.at(1, 4), kWhite);  // the narrower image is centred: columns 2..3
+  EXPECT_EQ(s.at(2, 4), kBlue);
+  EXPECT_EQ(s.at(3, 6), kBlue);
+  EXPECT_THROW(stack({}), InvalidInputError);
+}
+
+TEST(Compose, LegendBarShowsTheRampBetweenItsTicks) {
+  // Scale 1: title at y 2..8, bar at y 11..16, ticks to y 18, numbers at y 20..26, 2 pixels under.
+  // The widest number ("4" ... "8") is 5 pixels: the bar runs from x = 2 + 2 = 4 over 392 pixels.
+  ColorLegend legend;
+  legend.title = "metric";
+  legend.low = 4.0;
+  legend.high = 8.0;
+  legend.ramp = {{0, 1, 0}, {1, 1, 0}, {1, 0, 0}};
+  legend.swatches = {{"fold", {1, 0, 1}}};
+  ComposeOptions options;
+  options.text_scale = 1;
+  const Image key = draw_legend(legend, 400, options);
+  EXPECT_EQ(key.width, 400);
+  EXPECT_EQ(key.height, 29);
+  // Column 150 of the bar: its centre is at 146.5 / 392 of the bar, 0.747 of the way from green
+  // to yellow (the ramp has two segments over the bar).
+  const double t = 146.5 / 392.0 * 2.0;
+  EXPECT_NEAR(key.at(150, 14).x(), t, 1e-6);
+  EXPECT_FLOAT_EQ(key.at(150, 14).y(), 1.0f);
+  EXPECT_FLOAT_EQ(key.at(150, 14).z(), 0.0f);
+  // The right end is red but for the half pixel; the left end green.
+  EXPECT_NEAR(key.at(394, 14).y(), 2.0 * (1.0 - 390.5 / 392.0), 1e-6);
+  EXPECT_NEAR(key.at(5, 14).x(), 1.5 / 392.0 * 2.0, 1e-6);
+  // The fold swatch is on the title line, and the numbers are drawn under the bar.
+  bool swatch = false, numbers = false;
+  for (int y = 0; y < key.height; ++y) {
+    for (int x = 0; x < key.width; ++x) {
+      swatch |= y < 10 && key.at(x, y) == Eigen::Vector4f(1, 0, 1, 1);
+      numbers |= y >= 20 && key.at(x, y).x() < 0.5f;
+    }
+  }
+  EXPECT_TRUE(swatch);
+  EXPECT_TRUE(numbers);
+  legend.ramp.pop_back();
+  legend.ramp.pop_back();
+  EXPECT_THROW(draw_legend(legend, 400, options), InvalidInputError);
+  legend.ramp = {{0, 1, 0}, {1, 0, 0}};
+  legend.high = legend.low;
+  EXPECT_THROW(draw_legend(legend, 400, options), InvalidInputError);
 }
 
 TEST(Compose, RejectsBadInput) {

@@ -10,6 +10,7 @@
 #include "elastic/core/error.h"
 #include "elastic/image/image.h"
 #include "elastic/mapping/map_regions.h"
+#include "elastic/mesh/default_material.h"
 #include "elastic/mesh/mesh_io.h"
 #include "elastic/regions/image_source.h"
 #include "elastic/regions/region_spec.h"
@@ -19,6 +20,7 @@
 #include "elastic/surface/limit_tessellation.h"
 #include "elastic/transfer/bake.h"
 #include "elastic/transfer/color_source.h"
+#include "elastic/transfer/output_folder.h"
 #include "elastic/transfer/painted_surface.h"
 #include "elastic/transfer/target_samples.h"
 #include "rigid_motion.h"
@@ -409,7 +411,10 @@ TEST(PaintTexture, DecalFilesReadBackWithTheDecalMaterialAndUnitUvs) {
   const PaintedSurface painted =
       paint_surface(*t.pair->target_surface, *t.pair->to, t.pair->mapping(), options);
   const auto files = write_decal(t.dir / "decal.obj", painted, source);
-  ASSERT_EQ(files.size(), 3u);
+  // obj, mtl, the decal png, and the target's own texture copied in (the moved image plane's
+  // material names source.png, which already lies in this folder: used where it is).
+  ASSERT_EQ(files.size(), 4u);
+  EXPECT_EQ(files[3], t.dir / "source.png");
   for (const auto& f : files) EXPECT_TRUE(std::filesystem::exists(f)) << f;
 
   const PolygonMesh written = make_decal_mesh(painted, source, {.texture_path = files[2]});
@@ -591,6 +596,121 @@ TEST(PaintPly, ColouredMeshRoundTripsThroughThePlyReader) {
   for (int v = 0; v < mesh.num_vertices(); ++v) {
     EXPECT_LT((mesh.vertex_colors[v] - linear_color(inverse * mesh.positions[v])).norm(), 1e-5f);
   }
+}
+
+TEST(PaintPly, TransparentTexelsShowTheTargetsOwnColour) {
+  // A fully transparent source (every texel (0, 0, 0, 0)) pasted onto the moved image plane,
+  // whose own look is its checker texture: the region shows the target's texture, not black.
+  TexturedPair t("transparent");
+  const ColorSource clear = ColorSource::texture(
+      *t.pair->source_surface, Image(32, 32, Eigen::Vector4f(0, 0, 0, 0)), "clear");
+  PaintedSurfaceOptions options;
+  options.resolution = 4;
+  options.sampling = t.pair->sampling();
+  options.sampling.max_edge = 0.1;
+  const PaintedSurface painted =
+      paint_surface(*t.pair->target_surface, *t.pair->to, t.pair->mapping(), options);
+  const PolygonMesh mesh = make_colored_mesh(painted, clear);
+  const Image checker_image = read_image(t.dir / "source.png");
+  int region = 0;
+  for (int v = 0; v < mesh.num_vertices(); ++v) {
+    // The target's own colour: its texture at its UV (Repeat, as TargetColor documents).
+    const SurfacePoint& p = painted.points[static_cast<size_t>(v)];
+    const Eigen::Vector3f own =
+        sample(checker_image, texture_coordinate(*t.pair->target_surface, p), ImageWrap::Repeat)
+            .head<3>();
+    EXPECT_LT((mesh.vertex_colors[static_cast<size_t>(v)] - own).cwiseAbs().maxCoeff(), 1e-6f) << v;
+    region += painted.vertex_sample[static_cast<size_t>(v)] >= 0 ? 1 : 0;
+  }
+  EXPECT_GT(region, 100);
+  // A target without colours, texture or material shows the default material's grey.
+  PolygonMesh bare = plane_with_linear_colors();
+  bare.vertex_colors.clear();
+  const auto pair = rigid_disk_pair(bare, test::rigid_motion());
+  const TargetColor own(*pair->target_surface);
+  EXPECT_EQ(own(SurfacePoint{0, 0.5, 0.5}), Eigen::Vector3f(0.8f, 0.8f, 0.8f));
+  EXPECT_EQ(own(SurfacePoint{1, 0.1, 0.2}), default_material().diffuse.cast<float>());
+}
+
+TEST(PaintFiles, OutputFolderCopiesTexturesInUnderFreeBareNames) {
+  const auto dir = test::scratch_dir("output_folder");
+  std::filesystem::create_directories(dir / "a");
+  std::filesystem::create_directories(dir / "b");
+  write_png(dir / "a" / "tex.png", Image(2, 2, Eigen::Vector4f(1, 0, 0, 1)));
+  write_png(dir / "b" / "tex.png", Image(2, 2, Eigen::Vector4f(0, 0, 1, 1)));
+  OutputFolder folder(dir / "out");
+  EXPECT_EQ(folder.copy_in(dir / "a" / "tex.png"), dir / "out" / "tex.png");
+  EXPECT_EQ(folder.copy_in(dir / "a" / ".." / "a" / "tex.png"), dir / "out" / "tex.png");  // once
+  EXPECT_EQ(folder.copy_in(dir / "b" / "tex.png"), dir / "out" / "tex_2.png");
+  EXPECT_EQ(read_image(dir / "out" / "tex_2.png").at(0, 0), Eigen::Vector4f(0, 0, 1, 1));
+  EXPECT_THROW(folder.write_image("tex.png", Image(1, 1)), InvalidInputError);
+  EXPECT_THROW(folder.write_image("sub/x.png", Image(1, 1)), InvalidInputError);
+  EXPECT_THROW(folder.copy_in(dir / "missing.png"), IoError);
+
+  // An OBJ whose materials name textures elsewhere (and one that does not exist) stands alone:
+  // every face has a material, every map_Kd is a bare name of a file in the folder.
+  PolygonMesh mesh;
+  mesh.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 1, 0}};
+  mesh.add_face({0, 1, 2});
+  mesh.add_face({1, 3, 2});
+  mesh.add_face({0, 2, 3});
+  mesh.materials = {{"red", {1, 0, 0}, dir / "a" / "tex.png"},
+                    {"lost", {0, 1, 0}, dir / "nowhere.png"}};
+  mesh.face_materials = {0, 1, -1};
+  folder.write_obj("m.obj", mesh);
+  EXPECT_EQ(folder.warnings().size(), 1u);
+  std::stringstream mtl;
+  mtl << std::ifstream(dir / "out" / "m.mtl").rdbuf();
+  EXPECT_NE(mtl.str().find("map_Kd tex.png\n"), std::string::npos) << mtl.str();
+  EXPECT_EQ(mtl.str().find("nowhere"), std::string::npos) << mtl.str();
+  // Moved elsewhere, the folder still resolves.
+  std::filesystem::rename(dir / "out", dir / "moved");
+  const PolygonMesh read = read_mesh(dir / "moved" / "m.obj").mesh;
+  ASSERT_EQ(read.face_materials.size(), 3u);
+  for (const int m : read.face_materials) EXPECT_GE(m, 0);
+  EXPECT_EQ(read.materials[static_cast<size_t>(read.face_materials[2])].name, "default");
+  EXPECT_EQ(read.materials[0].diffuse_texture, dir / "moved" / "tex.png");
+  EXPECT_TRUE(std::filesystem::exists(read.materials[0].diffuse_texture));
+}
+
+TEST(PaintFiles, BakedAndTargetMeshesKeepTheTargetsUvsAndMaterials) {
+  TexturedPair t("baked_mesh");
+  PaintedSurfaceOptions options;
+  options.resolution = 4;
+  options.sampling = t.pair->sampling();
+  const PaintedSurface painted =
+      paint_surface(*t.pair->target_surface, *t.pair->to, t.pair->mapping(), options);
+  const PolygonMesh target = make_target_mesh(painted);
+  ASSERT_EQ(target.num_faces(), painted.num_triangles());
+  ASSERT_TRUE(target.has_texcoords());
+  for (int f = 0; f < target.num_faces(); ++f) {
+    EXPECT_EQ(target.materials[static_cast<size_t>(target.face_materials[f])].name, "image");
+    for (int k = 0; k < 3; ++k) {
+      const int corner = target.face_offsets[f] + k;
+      const Eigen::Vector2d& st =
+          painted.triangle_uv[static_cast<size_t>(f)][static_cast<size_t>(k)];
+      const Eigen::Vector2d uv = texture_coordinate(
+          *t.pair->target_surface,
+          SurfacePoint{painted.triangle_face[static_cast<size_t>(f)], st.x(), st.y()});
+      EXPECT_EQ(target.texcoords[static_cast<size_t>(target.corner_texcoords[corner])], uv);
+    }
+  }
+  // Pooled per vertex: about one UV per vertex on a seamless plane, not one per corner.
+  EXPECT_LT(target.texcoords.size(), 2 * target.positions.size());
+  std::vector<Eigen::Vector3d> moved = painted.positions;
+  for (auto& p : moved) p.z() += 1.0;
+  EXPECT_EQ(make_target_mesh(painted, moved).positions[0], moved[0]);
+  EXPECT_THROW(make_target_mesh(painted, std::span(moved).first(3)), InvalidInputError);
+
+  // The bake's mesh: the material that named the baked-into image names the bake.
+  const PolygonMesh baked = make_baked_mesh(painted, t.dir / "baked.png", t.dir / "source.png");
+  ASSERT_EQ(baked.materials.size(), 1u);
+  EXPECT_EQ(baked.materials[0].diffuse_texture, t.dir / "baked.png");
+  // A bake into an image of its own: one material "baked" on every face.
+  const PolygonMesh own = make_baked_mesh(painted, t.dir / "baked.png", t.dir / "other.png");
+  ASSERT_EQ(own.materials.size(), 1u);
+  EXPECT_EQ(own.materials[0].name, "baked");
+  EXPECT_EQ(own.face_materials, std::vector<int>(static_cast<size_t>(own.num_faces()), 0));
 }
 
 }  // namespace

@@ -14,11 +14,13 @@
 #include "elastic/core/error.h"
 #include "elastic/image/image.h"
 #include "elastic/mesh/mesh_io.h"
+#include "elastic/metrics/heatmap.h"
 #include "elastic/regions/texture_coordinates.h"
 #include "elastic/transfer/bake.h"
 #include "elastic/transfer/color_source.h"
 #include "elastic/transfer/displacement.h"
 #include "elastic/transfer/geometric_detail.h"
+#include "elastic/transfer/output_folder.h"
 #include "elastic/transfer/painted_surface.h"
 #include "elastic/transfer/tangent_frames.h"
 #include "job_file.h"
@@ -157,6 +159,26 @@ std::optional<ColorSource> make_color_source(const PasteArgs& a, const LimitSurf
   return std::nullopt;
 }
 
+// The colour scale of the heatmaps, as the report records it (docs/file-formats.md).
+nlohmann::json heatmap_scale_json(const HeatmapOptions& scale,
+                                  const std::vector<std::string>& methods) {
+  const auto rgb = [](const Eigen::Vector3f& c) {
+    return nlohmann::json::array({c.x(), c.y(), c.z()});
+  };
+  const std::vector<Eigen::Vector3f> stops = heatmap_ramp_stops();
+  return {{"metric", std::string(to_string(scale.metric))},
+          {"min", scale.low.value_or(0.0)},
+          {"max", scale.high.value_or(0.0)},
+          {"percentile", scale.percentile},
+          {"colors",
+           {{"min", rgb(stops[0])},
+            {"mid", rgb(stops[1])},
+            {"max", rgb(stops[2])},
+            {"fold", rgb(scale.fold_color)},
+            {"excluded", rgb(scale.excluded_color)}}},
+          {"methods", methods}};
+}
+
 int run_paste(const PasteArgs& a, const CLI::App& sub) {
   require_flag(a.out, "--out");
   require_flag(a.job.target, "--target");
@@ -185,6 +207,9 @@ int run_paste(const PasteArgs& a, const CLI::App& sub) {
   const LimitSurface& source = *session->source.surface;
   const LimitSurface& target = *session->target.surface;
   nlohmann::json report = map_report(a.job, *session, job_of(sub));
+  // Every file the paste writes goes through the folder, which keeps it self-contained: textures
+  // are copied in and referenced by bare names, every OBJ face has a material.
+  OutputFolder folder(dir);
   std::vector<std::filesystem::path> files;
 
   const std::optional<ColorSource> colors = make_color_source(a, source);
@@ -235,10 +260,9 @@ int run_paste(const PasteArgs& a, const CLI::App& sub) {
 
   if (colors) {
     if (colors->kind() == ColorSourceKind::Texture) {
-      for (const auto& f : write_decal(dir / "painted.obj", painted, *colors)) files.push_back(f);
+      write_decal(folder, "painted.obj", painted, *colors);
     }
-    write_mesh(dir / "colors.ply", make_colored_mesh(painted, *colors));
-    files.push_back(dir / "colors.ply");
+    folder.write_mesh("colors.ply", make_colored_mesh(painted, *colors));
     if (a.bake) {
       const std::filesystem::path input = a.bake_texture.empty()
                                               ? first_map_kd(target.control_mesh())
@@ -248,11 +272,11 @@ int run_paste(const PasteArgs& a, const CLI::App& sub) {
       bake.feather = a.feather;
       bake.name = input.string();
       const BakeResult baked = bake_texture(samples, target, *colors, read_image(input), bake);
-      const std::filesystem::path out = dir / "baked.png";
-      if (same_file(out, input))
+      if (same_file(dir / "baked.png", input))
         throw UsageError("refusing to overwrite the input texture " + input.string());
-      write_png(out, baked.image);
-      files.push_back(out);
+      const std::filesystem::path out = folder.write_image("baked.png", baked.image);
+      // The target with its own UVs and materials, the baked image in place of the input's.
+      folder.write_obj("baked.obj", make_baked_mesh(painted, out, input));
       paste["texels_painted"] = baked.texels_painted;
       paste["texels_changed"] = baked.texels_changed;
     }
@@ -297,15 +321,13 @@ int run_paste(const PasteArgs& a, const CLI::App& sub) {
     displacement.falloff_width = a.falloff;
     const DisplacementResult moved = displace_along_normals(
         samples.positions, samples.normals, heights, samples.triangles, displacement);
-    PolygonMesh mesh;
-    mesh.positions = painted.positions;
+    std::vector<Eigen::Vector3d> positions = painted.positions;
     for (int j = 0; j < samples.num_vertices(); ++j) {
-      mesh.positions[static_cast<size_t>(painted.sample_vertex_index[static_cast<size_t>(j)])] =
+      positions[static_cast<size_t>(painted.sample_vertex_index[static_cast<size_t>(j)])] =
           moved.positions[static_cast<size_t>(j)];
     }
-    for (const Eigen::Vector3i& t : painted.triangles) mesh.add_face({t[0], t[1], t[2]});
-    write_mesh(dir / "displaced.obj", mesh);
-    files.push_back(dir / "displaced.obj");
+    // The target's own UVs and materials (its texture copied in), on the displaced positions.
+    folder.write_obj("displaced.obj", make_target_mesh(painted, positions));
     paste["max_displacement"] = moved.max_displacement;
   }
 
@@ -317,8 +339,7 @@ int run_paste(const PasteArgs& a, const CLI::App& sub) {
     PasteDetailOptions detail;
     detail.scale = a.detail_scale;
     const PasteDetailResult pasted = paste_detail(field, result.mapping, differential, detail);
-    write_mesh(dir / "detail.obj", pasted.mesh);
-    files.push_back(dir / "detail.obj");
+    folder.write_obj("detail.obj", pasted.mesh);
     paste["detail_outside"] = pasted.outside;
     paste["detail_dropped_faces"] = pasted.dropped_faces;
   }
@@ -337,12 +358,26 @@ int run_paste(const PasteArgs& a, const CLI::App& sub) {
   for (const MethodMeasurement& m : methods) metrics[m.name] = measurement_json(m);
   report["metrics"] = metrics;
   // The distortion heatmap of Fig. 9 (symmetric Dirichlet per grid triangle, green = perfect) as
-  // PLY face and vertex colours.
+  // PLY face and vertex colours, on one colour scale for every method measured (the preview's),
+  // recorded in the report. heatmap.ply is ElasticPaint's, heatmap_<baseline>.ply the baseline's.
+  std::vector<const MapMetrics*> measured_metrics;
+  std::vector<std::string> measured_names;
   for (const MethodMeasurement& m : methods) {
-    if (m.name != "elastic" || !m.ok) continue;
-    write_mesh(dir / "heatmap.ply", make_heatmap(m.positions, m.metrics).mesh);
-    files.push_back(dir / "heatmap.ply");
+    if (!m.ok || m.name == "naive") continue;
+    measured_metrics.push_back(&m.metrics);
+    measured_names.push_back(m.name);
   }
+  HeatmapOptions heat_scale;
+  if (!measured_metrics.empty()) {
+    heat_scale = shared_heatmap_scale(measured_metrics);
+    for (const MethodMeasurement& m : methods) {
+      if (!m.ok || m.name == "naive") continue;
+      const std::string name = m.name == "elastic" ? "heatmap.ply" : "heatmap_" + m.name + ".ply";
+      folder.write_mesh(name, make_heatmap(m.positions, m.metrics, heat_scale).mesh);
+    }
+    report["heatmap"] = heatmap_scale_json(heat_scale, measured_names);
+  }
+  files = folder.files();
 
   if (a.preview || a.frames > 0) {
     PolygonMesh surface, outside;
@@ -376,8 +411,10 @@ int run_paste(const PasteArgs& a, const CLI::App& sub) {
         measured.push_back(&m.metrics);
         labels.push_back(m.name == "elastic" ? "ElasticPaint" : m.name);
       }
-      files.push_back(
-          preview.write_heatmaps(dir / "preview_heatmap.png", positions, measured, labels));
+      if (!positions.empty()) {
+        files.push_back(preview.write_heatmaps(dir / "preview_heatmap.png", positions, measured,
+                                               labels, heat_scale));
+      }
     }
     if (!frames.empty()) {
       for (const auto& f : preview.write_frames(dir / "frames", grid, frames, frame_iterations)) {
@@ -388,6 +425,8 @@ int run_paste(const PasteArgs& a, const CLI::App& sub) {
   nlohmann::json list = nlohmann::json::array();
   for (const auto& f : files) list.push_back(f.string());
   report["files"] = list;
+  if (!folder.warnings().empty()) report["paste"]["warnings"] = folder.warnings();
+  print_warnings(folder.warnings(), a.job.quiet);
   const std::string report_path =
       a.job.report.empty() ? (dir / "report.json").string() : a.job.report;
   write_report(report_path, report);

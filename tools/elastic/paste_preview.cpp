@@ -93,18 +93,12 @@ std::filesystem::path PreviewWriter::write_grids(
 
 std::filesystem::path PreviewWriter::write_heatmaps(
     const std::filesystem::path& png, const std::vector<const Eigen::Matrix3Xd*>& positions,
-    const std::vector<const MapMetrics*>& metrics, const std::vector<std::string>& labels) const {
-  // One colour range for all: from the perfect value (green) to the largest of the methods'
-  // automatic highs (their 95th percentiles), so the worst method's bulk is red.
-  HeatmapOptions shared;
-  for (size_t k = 0; k < positions.size(); ++k) {
-    const HeatmapResult own = make_heatmap(*positions[k], *metrics[k], {});
-    shared.low = own.low;
-    shared.high = std::max(shared.high.value_or(own.high), own.high);
-  }
+    const std::vector<const MapMetrics*>& metrics, const std::vector<std::string>& labels,
+    const HeatmapOptions& scale) const {
   std::vector<Image> pictures;
+  HeatmapResult heat;
   for (size_t k = 0; k < positions.size(); ++k) {
-    const HeatmapResult heat = make_heatmap(*positions[k], *metrics[k], shared);
+    heat = make_heatmap(*positions[k], *metrics[k], scale);
     Scene scene;
     if (outside_.num_faces() > 0) scene.objects.push_back(surface_object(outside_));
     SceneObject object;
@@ -113,7 +107,22 @@ std::filesystem::path PreviewWriter::write_heatmaps(
     scene.objects.push_back(std::move(object));
     pictures.push_back(render(scene, camera_, render_options(settings_)));
   }
-  write_png(png, side_by_side(pictures, labels));
+  const Image row = side_by_side(pictures, labels);
+  // The key under the pictures: the metric's name, its range on the shared scale, the colours
+  // outside the ramp.
+  std::string title(to_string(scale.metric));
+  std::replace(title.begin(), title.end(), '_', ' ');
+  ColorLegend legend;
+  legend.title = title;
+  legend.low = heat.low;
+  legend.high = heat.high;
+  legend.ramp = heatmap_ramp_stops();
+  legend.swatches = {{"fold", scale.fold_color}, {"outside", scale.excluded_color}};
+  ComposeOptions compose;
+  compose.gap = 0;
+  compose.text_scale = std::max(1, settings_.width / 160);
+  const Image key = draw_legend(legend, row.width, compose);
+  write_png(png, stack({row, key}, compose));
   return png;
 }
 

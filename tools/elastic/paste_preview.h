@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "elastic/mesh/polygon_mesh.h"
+#include "elastic/metrics/heatmap.h"
 #include "elastic/metrics/map_metrics.h"
 #include "elastic/particles/particle_grid.h"
 #include "elastic/regions/region.h"
@@ -42,12 +43,15 @@ class PreviewWriter {
   std::filesystem::path write_grids(const std::filesystem::path& png, const ParticleGrid& grid,
                                     const std::vector<const Eigen::Matrix3Xd*>& positions,
                                     const std::vector<std::string>& labels) const;
-  /// Heatmaps of the symmetric Dirichlet energy per triangle, one per method, on one colour range
-  /// (perfect = green up to the largest of the methods' 95th percentiles = red), side by side.
+  /// Heatmaps of one per-triangle metric, one per method, side by side on the colour scale
+  /// `scale` (shared_heatmap_scale of metrics/heatmap.h: perfect = green up to the largest of the
+  /// methods' 95th percentiles = red), with a legend bar (the metric, its numbers, the fold and
+  /// outside colours) under them.
   std::filesystem::path write_heatmaps(const std::filesystem::path& png,
                                        const std::vector<const Eigen::Matrix3Xd*>& positions,
                                        const std::vector<const MapMetrics*>& metrics,
-                                       const std::vector<std::string>& labels) const;
+                                       const std::vector<std::string>& labels,
+                                       const HeatmapOptions& scale) const;
   /// Frames of the relaxation: frames/frame_0001.png ... and a labelled contact sheet.
   std::vector<std::filesystem::path> write_frames(const std::filesystem::path& dir,
                                                   const ParticleGrid& grid,

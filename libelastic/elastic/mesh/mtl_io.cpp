@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <filesystem>
 
+#include "elastic/mesh/default_material.h"
 #include "elastic/mesh/detail/io_common.h"
 
 namespace elastic::detail {
@@ -89,7 +90,16 @@ bool read_mtl(const std::filesystem::path& path, std::vector<Material>& material
 std::string write_mtl(const PolygonMesh& mesh, const std::filesystem::path& mtl_path) {
   std::string out = "# written by libelastic\n";
   const std::filesystem::path folder = std::filesystem::absolute(mtl_path).parent_path();
-  for (const Material& m : mesh.materials) {
+  // Faces without a material are written under `usemtl default` (write_obj): define it.
+  std::vector<Material> materials = mesh.materials;
+  const bool unassigned = mesh.face_materials.size() != static_cast<size_t>(mesh.num_faces()) ||
+                          std::any_of(mesh.face_materials.begin(), mesh.face_materials.end(),
+                                      [](int m) { return m < 0; });
+  if (unassigned && std::none_of(materials.begin(), materials.end(),
+                                 [](const Material& m) { return m.name == "default"; })) {
+    materials.push_back(default_material());
+  }
+  for (const Material& m : materials) {
     out += "newmtl " + m.name + "\nKd";
     for (int k = 0; k < 3; ++k) {
       out += ' ';

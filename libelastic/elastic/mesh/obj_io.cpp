@@ -386,13 +386,17 @@ std::string write_obj(const PolygonMesh& mesh, const MeshWriteOptions& options,
       out += '\n';
     }
   }
-  const bool materials = !mesh.face_materials.empty();
-  int current_material = -1;  // faces before the first `usemtl` have none
+  // With a material library, every face is written under a `usemtl`: OBJ has no "no material"
+  // statement, and readers put faces before the first `usemtl` on a material of their own choice
+  // (often the library's first). Faces without a material are written under "default", which
+  // write_mtl defines (default_material()) unless the mesh has a material of that name.
+  const bool materials = !mesh.materials.empty();
+  int current_material = -2;  // no `usemtl` written yet
   for (int f = 0; f < mesh.num_faces(); ++f) {
-    if (materials && mesh.face_materials[static_cast<size_t>(f)] != current_material) {
-      current_material = mesh.face_materials[static_cast<size_t>(f)];
-      // OBJ has no "no material" statement: faces without one after faces with one are written
-      // under the conventional name "default" (read back as a material of that name).
+    const int material =
+        mesh.face_materials.empty() ? -1 : mesh.face_materials[static_cast<size_t>(f)];
+    if (materials && material != current_material) {
+      current_material = material;
       out += "usemtl ";
       out += current_material >= 0 ? mesh.materials[static_cast<size_t>(current_material)].name
                                    : std::string("default");

@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <array>
 #include <cctype>
+#include <cmath>
+#include <cstdio>
 #include <string>
 
 #include "elastic/core/error.h"
@@ -180,6 +182,124 @@ Image side_by_side(const std::vector<Image>& images, const std::vector<std::stri
 Image contact_sheet(const std::vector<Image>& frames, int columns,
                     const std::vector<std::string>& labels, const ComposeOptions& options) {
   return compose(frames, columns, labels, options, "contact_sheet");
+}
+
+namespace {
+void fill_rect(Image& image, int x0, int y0, int w, int h, const Eigen::Vector4f& color) {
+  for (int y = std::max(0, y0); y < std::min(image.height, y0 + h); ++y) {
+    for (int x = std::max(0, x0); x < std::min(image.width, x0 + w); ++x) {
+      image.at(x, y) = color;
+    }
+  }
+}
+
+std::string tick_text(double value) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.4g", value == 0.0 ? 0.0 : value);  // no "-0"
+  return text;
+}
+}  // namespace
+
+Image draw_legend(const ColorLegend& legend, int width, const ComposeOptions& options) {
+  const std::string name = "legend";
+  if (legend.ramp.size() < 2) {
+    throw InvalidInputError(name, "a colour ramp needs at least 2 colours");
+  }
+  if (legend.ticks < 2) {
+    throw InvalidInputError(name, "at least 2 ticks");
+  }
+  if (!std::isfinite(legend.low) || !std::isfinite(legend.high) || !(legend.high > legend.low)) {
+    throw InvalidInputError(name, "the range must be finite and increasing");
+  }
+  if (options.text_scale < 0) {
+    throw InvalidInputError(name, "text scale must not be negative");
+  }
+  const int s = options.text_scale > 0 ? options.text_scale : std::max(1, width / 320);
+  const int pad = 2 * s;
+  std::vector<std::string> labels;
+  int widest = 0;
+  for (int k = 0; k < legend.ticks; ++k) {
+    const double t = static_cast<double>(k) / (legend.ticks - 1);
+    labels.push_back(tick_text(legend.low + t * (legend.high - legend.low)));
+    widest = std::max(widest, text_size(labels.back(), s).x());
+  }
+  // The bar leaves room for half of the end labels on either side.
+  const int margin = pad + widest / 2;
+  const int bar_x = margin, bar_w = width - 2 * margin;
+  if (bar_w < 2 * legend.ticks) {
+    throw InvalidInputError(name, "width " + std::to_string(width) + " is too small");
+  }
+  const int title_y = pad, bar_y = title_y + 7 * s + pad, bar_h = 6 * s;
+  const int tick_y = bar_y + bar_h, tick_h = 2 * s, text_y = tick_y + tick_h + s;
+  Image image(width, text_y + 7 * s + pad, options.background);
+
+  draw_text(image, bar_x, title_y, legend.title, s, options.text_color);
+  // Swatches right-aligned on the title line: a square, a space, the name.
+  int x = width - margin;
+  for (auto it = legend.swatches.rbegin(); it != legend.swatches.rend(); ++it) {
+    const int text_w = text_size(it->first, s).x();
+    x -= text_w;
+    draw_text(image, x, title_y, it->first, s, options.text_color);
+    x -= 7 * s + s;
+    fill_rect(image, x, title_y, 7 * s, 7 * s, options.text_color);
+    fill_rect(image, x + std::max(1, s / 2), title_y + std::max(1, s / 2),
+              7 * s - 2 * std::max(1, s / 2), 7 * s - 2 * std::max(1, s / 2),
+              {it->second.x(), it->second.y(), it->second.z(), 1.0f});
+    x -= 3 * s;
+  }
+  // The bar: pixel column i shows the ramp at its centre's value.
+  const int segments = static_cast<int>(legend.ramp.size()) - 1;
+  for (int i = 0; i < bar_w; ++i) {
+    const double t = (i + 0.5) / bar_w * segments;
+    const int k = std::min(segments - 1, static_cast<int>(t));
+    const float f = static_cast<float>(t - k);
+    const Eigen::Vector3f c = (1.0f - f) * legend.ramp[static_cast<size_t>(k)] +
+                              f * legend.ramp[static_cast<size_t>(k) + 1];
+    fill_rect(image, bar_x + i, bar_y, 1, bar_h, {c.x(), c.y(), c.z(), 1.0f});
+  }
+  // A thin frame around the bar, tick marks and their values centred under them.
+  const int line = std::max(1, s / 3);
+  fill_rect(image, bar_x, bar_y, bar_w, line, options.text_color);
+  fill_rect(image, bar_x, bar_y + bar_h - line, bar_w, line, options.text_color);
+  for (int k = 0; k < legend.ticks; ++k) {
+    const int tx =
+        bar_x +
+        static_cast<int>(std::lround(static_cast<double>(k) * (bar_w - line) / (legend.ticks - 1)));
+    fill_rect(image, tx, bar_y, line, bar_h + tick_h, options.text_color);
+    const int text_w = text_size(labels[static_cast<size_t>(k)], s).x();
+    draw_text(image, tx - text_w / 2, text_y, labels[static_cast<size_t>(k)], s,
+              options.text_color);
+  }
+  return image;
+}
+
+Image stack(const std::vector<Image>& images, const ComposeOptions& options) {
+  if (images.empty()) {
+    throw InvalidInputError("stack", "no images to stack");
+  }
+  if (options.gap < 0) {
+    throw InvalidInputError("stack", "gap must not be negative");
+  }
+  int width = 0, height = options.gap;
+  for (size_t i = 0; i < images.size(); ++i) {
+    if (images[i].empty()) {
+      throw InvalidInputError("stack", "image " + std::to_string(i) + " is empty");
+    }
+    width = std::max(width, images[i].width);
+    height += images[i].height + options.gap;
+  }
+  Image sheet(width + 2 * options.gap, height, options.background);
+  int y0 = options.gap;
+  for (const Image& image : images) {
+    const int x0 = options.gap + (width - image.width) / 2;
+    for (int y = 0; y < image.height; ++y) {
+      for (int x = 0; x < image.width; ++x) {
+        sheet.at(x0 + x, y0 + y) = image.at(x, y);
+      }
+    }
+    y0 += image.height + options.gap;
+  }
+  return sheet;
 }
 
 }  // namespace elastic

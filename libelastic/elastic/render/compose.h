@@ -1,9 +1,9 @@
 #pragma once
 /// \file
 /// Putting pictures together: side-by-side comparisons (naive vs relaxed, Figs. 6 and 9 of the
-/// paper), contact sheets of relaxation frames, and short labels in a built-in 5 x 7 pixel bitmap
-/// font (digits, letters A-Z, lower case drawn as upper case, space and `- . , : / % = ( ) _ + ?`;
-/// any other character is drawn as `?`).
+/// paper), contact sheets of relaxation frames, colour legends for heatmaps, and short labels in a
+/// built-in 5 x 7 pixel bitmap font (digits, letters A-Z, lower case drawn as upper case, space and
+/// `- . , : / % = ( ) _ + ?`; any other character is drawn as `?`).
 ///
 /// All positions are in pixels of image/image.h's convention (x right, y down from the top row).
 /// Compositing copies pixels exactly (no resampling); an image smaller than its cell is centred in
@@ -12,6 +12,7 @@
 #include <Eigen/Core>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "elastic/image/image.h"
@@ -44,6 +45,32 @@ Image side_by_side(const std::vector<Image>& images, const std::vector<std::stri
 Image contact_sheet(const std::vector<Image>& frames, int columns,
                     const std::vector<std::string>& labels = {},
                     const ComposeOptions& options = {});
+
+/// A colour legend (the key of a heatmap): a title, a horizontal bar of a colour ramp from `low` at
+/// its left end to `high` at its right end, tick marks with their values under it, and swatches
+/// for colours outside the ramp (e.g. "fold").
+struct ColorLegend {
+  std::string title;  ///< e.g. "symmetric Dirichlet"
+  double low = 0.0;   ///< value at the bar's left end
+  double high = 1.0;  ///< value at the bar's right end, > low
+  /// Colours at evenly spaced values from low to high (at least 2), interpolated linearly between.
+  std::vector<Eigen::Vector3f> ramp;
+  /// Named colours drawn as squares on the title line, right-aligned.
+  std::vector<std::pair<std::string, Eigen::Vector3f>> swatches;
+  /// Number of labelled ticks, evenly spaced from low to high, >= 2.
+  int ticks = 5;
+};
+
+/// The legend as an image `width` pixels wide on options.background; text at options.text_scale
+/// (0: max(1, width / 320)). Tick values are printed with up to 4 significant digits (%.4g).
+/// \throws InvalidInputError ("legend") for fewer than 2 ramp colours or ticks, a range that is
+///         not finite or not increasing, or a width too small for the text.
+Image draw_legend(const ColorLegend& legend, int width, const ComposeOptions& options = {});
+
+/// Images one above the other, each centred horizontally, options.gap pixels between and around
+/// them, on options.background (e.g. a side-by-side picture above its legend).
+/// \throws InvalidInputError ("stack") for no images or an empty image.
+Image stack(const std::vector<Image>& images, const ComposeOptions& options = {});
 
 /// Width and height in pixels of `text` in the bitmap font at `scale`: 6 * scale per character
 /// (5 columns and 1 of spacing) minus the trailing spacing, and 7 * scale high.

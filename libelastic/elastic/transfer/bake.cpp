@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <system_error>
 
 #include "elastic/core/error.h"
 #include "elastic/regions/texture_coordinates.h"
@@ -185,6 +186,36 @@ BakeResult bake_texture(const TargetSamples& samples, const LimitSurface& target
     }
   }
   return result;
+}
+
+PolygonMesh make_baked_mesh(const PaintedSurface& painted,
+                            const std::filesystem::path& baked_texture,
+                            const std::filesystem::path& input_texture) {
+  if (!painted.surface->control_mesh().has_texcoords()) {
+    throw InvalidInputError(painted.surface->name(),
+                            "has no texture coordinates to show a baked texture");
+  }
+  PolygonMesh mesh = make_target_mesh(painted);
+  const auto same = [](const std::filesystem::path& a, const std::filesystem::path& b) {
+    std::error_code ec;
+    return std::filesystem::weakly_canonical(a, ec) == std::filesystem::weakly_canonical(b, ec);
+  };
+  bool named = false;
+  for (Material& m : mesh.materials) {
+    if (!m.diffuse_texture.empty() && same(m.diffuse_texture, input_texture)) {
+      m.diffuse_texture = baked_texture;
+      named = true;
+    }
+  }
+  if (!named) {
+    Material baked;
+    baked.name = "baked";
+    baked.diffuse = Eigen::Vector3d::Ones();
+    baked.diffuse_texture = baked_texture;
+    mesh.materials = {baked};
+    mesh.face_materials.assign(static_cast<size_t>(mesh.num_faces()), 0);
+  }
+  return mesh;
 }
 
 }  // namespace elastic

@@ -19,10 +19,12 @@
 /// copied unchanged: the input image is never modified (the result is a new image).
 
 #include <Eigen/Core>
+#include <filesystem>
 #include <string>
 
 #include "elastic/image/image.h"
 #include "elastic/transfer/color_source.h"
+#include "elastic/transfer/painted_surface.h"
 #include "elastic/transfer/target_samples.h"
 
 namespace elastic {
@@ -48,5 +50,15 @@ struct BakeResult {
 BakeResult bake_texture(const TargetSamples& samples, const LimitSurface& target,
                         const ColorSource& source, const Image& target_image,
                         const BakeOptions& options = {});
+
+/// The mesh that shows a bake: the painted target (make_target_mesh: its tessellation with the
+/// target's own texture coordinates and materials), where every material whose map_Kd is
+/// `input_texture` (the image that was baked into) now names `baked_texture`. When no material
+/// names it (a texture of its own, e.g. `paste --bake-texture`), every face gets one material
+/// "baked" (Kd 1, map_Kd `baked_texture`). Write it with OutputFolder::write_obj.
+/// \throws InvalidInputError naming the target when it has no texture coordinates.
+PolygonMesh make_baked_mesh(const PaintedSurface& painted,
+                            const std::filesystem::path& baked_texture,
+                            const std::filesystem::path& input_texture);
 
 }  // namespace elastic

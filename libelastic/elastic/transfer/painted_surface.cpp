@@ -3,11 +3,14 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
 #include <map>
+#include <optional>
 #include <utility>
 
 #include "elastic/core/error.h"
 #include "elastic/image/image.h"
+#include "elastic/mesh/default_material.h"
 #include "elastic/mesh/mesh_io.h"
 #include "elastic/regions/surface_partition.h"
 #include "elastic/regions/texture_coordinates.h"
@@ -166,6 +169,50 @@ namespace {
 void add_triangle_face(PolygonMesh& mesh, const Eigen::Vector3i& t) {
   mesh.add_face({t[0], t[1], t[2]});
 }
+
+/// The target's texture coordinates at the corners of painted triangles, pooled: one entry per
+/// distinct value at a vertex (exact comparison: corners of one vertex in the same chart get the
+/// same value from the same control corners up to round-off, which may leave a few duplicates,
+/// harmless), so UV seams stay seams and the pool is about the vertex count.
+class TargetUvPool {
+ public:
+  TargetUvPool(const PaintedSurface& painted, PolygonMesh& mesh)
+      : painted_(painted), mesh_(mesh), at_vertex_(painted.positions.size()) {}
+
+  /// The pool index of corner k of triangle t.
+  int corner(int t, int k) {
+    const Eigen::Vector2d& st =
+        painted_.triangle_uv[static_cast<size_t>(t)][static_cast<size_t>(k)];
+    const SurfacePoint p{painted_.triangle_face[static_cast<size_t>(t)], st.x(), st.y()};
+    const Eigen::Vector2d uv = texture_coordinate(*painted_.surface, p);
+    const int v = painted_.triangles[static_cast<size_t>(t)][k];
+    std::vector<int>& seen = at_vertex_[static_cast<size_t>(v)];
+    for (const int i : seen) {
+      if (mesh_.texcoords[static_cast<size_t>(i)] == uv) {
+        return i;
+      }
+    }
+    const int i = static_cast<int>(mesh_.texcoords.size());
+    mesh_.texcoords.push_back(uv);
+    seen.push_back(i);
+    return i;
+  }
+
+ private:
+  const PaintedSurface& painted_;
+  PolygonMesh& mesh_;
+  std::vector<std::vector<int>> at_vertex_;
+};
+
+/// The target material of painted triangle t (-1: none).
+int target_material(const PaintedSurface& painted, int t) {
+  const PolygonMesh& control = painted.surface->control_mesh();
+  if (control.face_materials.empty()) {
+    return -1;
+  }
+  const int face = painted.surface->control_face(painted.triangle_face[static_cast<size_t>(t)]);
+  return control.face_materials[static_cast<size_t>(face)];
+}
 }  // namespace
 
 PolygonMesh make_decal_mesh(const PaintedSurface& painted, const ColorSource& source,
@@ -199,15 +246,17 @@ PolygonMesh make_decal_mesh(const PaintedSurface& painted, const ColorSource& so
                     });
   const bool target_uv = control.has_texcoords();
   if (!target_uv) {
+    // Outside faces need a corner index too (every corner has one or none does); they are on the
+    // default material, which has no texture, so this coordinate indexes nothing.
     mesh.texcoords.emplace_back(0.0, 0.0);
   }
   const int sample_base = static_cast<int>(mesh.texcoords.size());
   mesh.texcoords.insert(mesh.texcoords.end(), source_uv.begin(), source_uv.end());
 
+  TargetUvPool pool(painted, mesh);
   for (int t = 0; t < painted.num_triangles(); ++t) {
     const Eigen::Vector3i& c = painted.triangles[static_cast<size_t>(t)];
     add_triangle_face(mesh, c);
-    const int face = painted.triangle_face[static_cast<size_t>(t)];
     if (painted.triangle_inside[static_cast<size_t>(t)]) {
       for (int k = 0; k < 3; ++k) {
         mesh.corner_texcoords.push_back(sample_base +
@@ -217,64 +266,191 @@ PolygonMesh make_decal_mesh(const PaintedSurface& painted, const ColorSource& so
       continue;
     }
     for (int k = 0; k < 3; ++k) {
-      if (target_uv) {
-        const Eigen::Vector2d& uv =
-            painted.triangle_uv[static_cast<size_t>(t)][static_cast<size_t>(k)];
-        mesh.corner_texcoords.push_back(static_cast<int>(mesh.texcoords.size()));
-        mesh.texcoords.push_back(texture_coordinate(target, SurfacePoint{face, uv.x(), uv.y()}));
-      } else {
-        mesh.corner_texcoords.push_back(0);
+      mesh.corner_texcoords.push_back(target_uv ? pool.corner(t, k) : 0);
+    }
+    mesh.face_materials.push_back(target_material(painted, t));
+  }
+  assign_default_material(mesh);
+  return mesh;
+}
+
+PolygonMesh make_target_mesh(const PaintedSurface& painted,
+                             std::span<const Eigen::Vector3d> positions) {
+  const LimitSurface& target = *painted.surface;
+  const PolygonMesh& control = target.control_mesh();
+  if (!positions.empty() && positions.size() != painted.positions.size()) {
+    throw InvalidInputError(target.name(), std::to_string(positions.size()) + " positions for " +
+                                               std::to_string(painted.positions.size()) +
+                                               " vertices of the painted target");
+  }
+  PolygonMesh mesh;
+  if (positions.empty()) {
+    mesh.positions = painted.positions;
+  } else {
+    mesh.positions.assign(positions.begin(), positions.end());
+  }
+  mesh.materials = control.materials;
+  const bool target_uv = control.has_texcoords();
+  TargetUvPool pool(painted, mesh);
+  for (int t = 0; t < painted.num_triangles(); ++t) {
+    add_triangle_face(mesh, painted.triangles[static_cast<size_t>(t)]);
+    if (target_uv) {
+      for (int k = 0; k < 3; ++k) {
+        mesh.corner_texcoords.push_back(pool.corner(t, k));
       }
     }
-    const int control_face = target.control_face(face);
-    mesh.face_materials.push_back(control.face_materials.empty()
-                                      ? -1
-                                      : control.face_materials[static_cast<size_t>(control_face)]);
+    mesh.face_materials.push_back(target_material(painted, t));
   }
+  assign_default_material(mesh);
   return mesh;
+}
+
+namespace {
+/// The colour the region's faces have without the decal when it is one flat colour (every region
+/// triangle on untextured materials of one Kd, or on none: the default grey); nullopt otherwise.
+std::optional<Eigen::Vector3f> flat_region_color(const PaintedSurface& painted) {
+  const PolygonMesh& control = painted.surface->control_mesh();
+  if (control.has_vertex_colors()) {
+    return std::nullopt;
+  }
+  std::optional<Eigen::Vector3d> color;
+  for (int t = 0; t < painted.num_triangles(); ++t) {
+    if (!painted.triangle_inside[static_cast<size_t>(t)]) {
+      continue;
+    }
+    const int m = target_material(painted, t);
+    const Material material =
+        m >= 0 ? control.materials[static_cast<size_t>(m)] : default_material();
+    if (!material.diffuse_texture.empty() || (color && *color != material.diffuse)) {
+      return std::nullopt;
+    }
+    color = material.diffuse;
+  }
+  if (!color) {
+    return std::nullopt;
+  }
+  return color->cast<float>();
+}
+}  // namespace
+
+std::vector<std::filesystem::path> write_decal(OutputFolder& folder, const std::string& name,
+                                               const PaintedSurface& painted,
+                                               const ColorSource& source,
+                                               const std::string& material_name) {
+  const std::filesystem::path obj_name(name);
+  const std::size_t before = folder.files().size();
+  // Viewers differ in what a texel's alpha means (some OBJ importers ignore it and show the
+  // transparent texels' colour, often black). Over a flat target colour the blend is known: write
+  // the decal composited over it, opaque. Over a textured target the blend needs the target's
+  // texture (that is the bake), so the image keeps its alpha.
+  Image image = source.image();
+  if (const std::optional<Eigen::Vector3f> under = flat_region_color(painted)) {
+    for (Eigen::Vector4f& texel : image.pixels) {
+      const float a = std::clamp(texel.w(), 0.0f, 1.0f);
+      texel.head<3>() = a * texel.head<3>() + (1.0f - a) * *under;
+      texel.w() = 1.0f;
+    }
+  }
+  const std::filesystem::path png =
+      folder.write_image(obj_name.stem().string() + "_decal.png", image);
+  DecalOptions options;
+  options.material_name = material_name;
+  options.texture_path = png;
+  const std::vector<std::filesystem::path> written =
+      folder.write_obj(obj_name.string(), make_decal_mesh(painted, source, options));
+  // obj, mtl, png, then the textures copied in for this OBJ.
+  std::vector<std::filesystem::path> out = written;
+  out.push_back(png);
+  for (std::size_t k = before; k < folder.files().size(); ++k) {
+    const std::filesystem::path& f = folder.files()[k];
+    if (std::find(out.begin(), out.end(), f) == out.end()) {
+      out.push_back(f);
+    }
+  }
+  return out;
 }
 
 std::vector<std::filesystem::path> write_decal(const std::filesystem::path& obj,
                                                const PaintedSurface& painted,
                                                const ColorSource& source,
                                                const std::string& material_name) {
-  std::filesystem::path png = obj;
-  png.replace_filename(obj.stem().string() + "_decal.png");
-  std::filesystem::path mtl = obj;
-  mtl.replace_extension(".mtl");
-  DecalOptions options;
-  options.material_name = material_name;
-  options.texture_path = png;
-  const PolygonMesh mesh = make_decal_mesh(painted, source, options);
-  write_png(png, source.image());
-  write_mesh(obj, mesh);
-  return {obj, mtl, png};
+  const std::filesystem::path dir = obj.has_parent_path() ? obj.parent_path() : ".";
+  OutputFolder folder(dir);
+  return write_decal(folder, obj.filename().string(), painted, source, material_name);
+}
+
+TargetColor::TargetColor(const LimitSurface& target, const Eigen::Vector3f& fallback)
+    : target_(&target), fallback_(fallback) {
+  const PolygonMesh& control = target.control_mesh();
+  images_.resize(control.materials.size());
+  if (control.has_vertex_colors() || !control.has_texcoords()) {
+    return;
+  }
+  for (size_t m = 0; m < control.materials.size(); ++m) {
+    const std::filesystem::path& file = control.materials[m].diffuse_texture;
+    if (file.empty()) {
+      continue;
+    }
+    try {
+      images_[m] = read_image(file);
+    } catch (const Error&) {
+      images_[m] = Image();  // unreadable: the material's Kd (documented)
+    }
+  }
+}
+
+Eigen::Vector3f TargetColor::operator()(const SurfacePoint& p) const {
+  const PolygonMesh& control = target_->control_mesh();
+  if (control.has_vertex_colors()) {
+    Eigen::Vector3d c = Eigen::Vector3d::Zero();
+    for (const auto& [vertex, weight] : control_vertex_weights(*target_, p)) {
+      c += weight * control.vertex_colors[static_cast<size_t>(vertex)].cast<double>();
+    }
+    return c.cast<float>();
+  }
+  if (control.face_materials.empty()) {
+    return fallback_;
+  }
+  const int m = control.face_materials[static_cast<size_t>(target_->control_face(p.face))];
+  if (m < 0) {
+    return fallback_;
+  }
+  Eigen::Vector3f kd = control.materials[static_cast<size_t>(m)].diffuse.cast<float>();
+  const Image& image = images_[static_cast<size_t>(m)];
+  if (image.empty()) {
+    return kd;
+  }
+  const Eigen::Vector4f texel = sample(image, texture_coordinate(*target_, p), ImageWrap::Repeat);
+  return texel.w() * texel.head<3>() + (1.0f - texel.w()) * kd;
 }
 
 PolygonMesh make_colored_mesh(const PaintedSurface& painted, const ColorSource& source,
-                              const Eigen::Vector3f& outside) {
+                              const Eigen::Vector3f& fallback) {
   const LimitSurface& target = *painted.surface;
-  const PolygonMesh& control = target.control_mesh();
   PolygonMesh mesh;
   mesh.positions = painted.positions;
   for (const Eigen::Vector3i& t : painted.triangles) {
     add_triangle_face(mesh, t);
   }
+  const TargetColor own(target, fallback);
   const std::vector<Eigen::Vector4f> inside = transfer_colors(painted.samples, source);
-  mesh.vertex_colors.resize(mesh.positions.size(), outside);
-  for (int v = 0; v < painted.num_vertices(); ++v) {
-    const int j = painted.vertex_sample[static_cast<size_t>(v)];
-    if (j >= 0) {
-      mesh.vertex_colors[static_cast<size_t>(v)] = inside[static_cast<size_t>(j)].head<3>();
-    } else if (control.has_vertex_colors()) {
-      Eigen::Vector3d c = Eigen::Vector3d::Zero();
-      for (const auto& [vertex, weight] :
-           control_vertex_weights(target, painted.points[static_cast<size_t>(v)])) {
-        c += weight * control.vertex_colors[static_cast<size_t>(vertex)].cast<double>();
-      }
-      mesh.vertex_colors[static_cast<size_t>(v)] = c.cast<float>();
-    }
-  }
+  mesh.vertex_colors.resize(mesh.positions.size(), fallback);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, mesh.positions.size()),
+                    [&](const tbb::blocked_range<size_t>& r) {
+                      for (size_t v = r.begin(); v != r.end(); ++v) {
+                        const Eigen::Vector3f base = own(painted.points[v]);
+                        const int j = painted.vertex_sample[v];
+                        if (j < 0) {
+                          mesh.vertex_colors[v] = base;
+                          continue;
+                        }
+                        // Straight alpha over the target: a transparent texel shows the target's
+                        // own colour.
+                        const Eigen::Vector4f& c = inside[static_cast<size_t>(j)];
+                        const float a = std::clamp(c.w(), 0.0f, 1.0f);
+                        mesh.vertex_colors[v] = a * c.head<3>() + (1.0f - a) * base;
+                      }
+                    });
   return mesh;
 }
 

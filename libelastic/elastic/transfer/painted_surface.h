@@ -24,11 +24,14 @@
 #include <Eigen/Core>
 #include <array>
 #include <filesystem>
+#include <span>
 #include <string>
 #include <vector>
 
+#include "elastic/image/image.h"
 #include "elastic/mesh/polygon_mesh.h"
 #include "elastic/transfer/color_source.h"
+#include "elastic/transfer/output_folder.h"
 #include "elastic/transfer/target_samples.h"
 
 namespace elastic {
@@ -87,24 +90,66 @@ struct DecalOptions {
 
 /// The decal mesh: positions of `painted`; outside faces with the target's interpolated texture
 /// coordinates (the single coordinate (0,0) when the target has none) and their control face's
-/// material (copied from the target); region faces with the source's texture coordinates at
-/// their corners and a new material `material_name` whose map_Kd is `texture_path`.
+/// material (copied from the target), or the default material (mesh/default_material.h) when
+/// that face has none, so no outside face ever shows the decal's texture;
+/// region faces with the source's texture coordinates at their corners and a new material
+/// `material_name` whose map_Kd is `texture_path`.
 /// \throws InvalidInputError naming the source when `source` is not a Texture source.
 PolygonMesh make_decal_mesh(const PaintedSurface& painted, const ColorSource& source,
                             const DecalOptions& options = {});
 
-/// Writes the decal: `obj` (+ the .mtl beside it, same stem) and the source image as
-/// "<stem>_decal.png" beside it, all atomically. Returns the written paths (obj, mtl, png).
-/// \throws IoError when a file cannot be written; InvalidInputError as make_decal_mesh.
+/// The target mesh of `painted` without the feature: every triangle with the target's own
+/// texture coordinates (interpolated at its corners in its ptex face; one pool entry per distinct
+/// value at a vertex, so UV seams stay seams) when the target has them, and its control face's
+/// material or the default one. `positions` (#V, e.g. displaced ones) replace painted.positions
+/// when given. Used for the displaced and the baked outputs, which keep the target's look.
+/// \throws InvalidInputError naming the target when `positions` has the wrong size.
+PolygonMesh make_target_mesh(const PaintedSurface& painted,
+                             std::span<const Eigen::Vector3d> positions = {});
+
+/// Writes the decal into `folder` (output_folder.h): `<name>.obj` + `.mtl`, the decal image
+/// `<name>_decal.png` and copies of the target's own textures, all referenced by bare names.
+/// Viewers differ in what a texel's alpha means (some OBJ importers ignore it), so when every
+/// region face is on an untextured material of one Kd (or on none: the default grey) and the target
+/// has no vertex colours, the decal image is composited over that colour and written opaque; on a
+/// textured target it keeps its alpha (the blend with the target's texture is the bake).
+/// Returns the written paths (obj, mtl, decal png, then any copied textures).
+/// \throws IoError when a file cannot be read or written; InvalidInputError as make_decal_mesh.
+std::vector<std::filesystem::path> write_decal(OutputFolder& folder, const std::string& name,
+                                               const PaintedSurface& painted,
+                                               const ColorSource& source,
+                                               const std::string& material_name = "decal");
+
+/// The same into the folder of `obj` ("<stem>_decal.png" beside it).
 std::vector<std::filesystem::path> write_decal(const std::filesystem::path& obj,
                                                const PaintedSurface& painted,
                                                const ColorSource& source,
                                                const std::string& material_name = "decal");
 
-/// The per-vertex colour mesh: region vertices (boundary included) carry the source colour,
-/// the others the target's own vertex colours interpolated (control_vertex_weights) or, when it
-/// has none, `outside`.
+/// The target's own colour at a point of it (no feature): its control mesh's vertex colours
+/// interpolated (control_vertex_weights); else the texture of the point's control-face material
+/// at its texture coordinate (bilinear, repeating; a texel's alpha blends it over the material's
+/// Kd, as render/render.h draws it); else that material's Kd; else `fallback`. Texture files that
+/// cannot be read are treated as absent (the material's Kd). Holds a reference to the surface;
+/// owns the images; queries are const and thread-safe.
+class TargetColor {
+ public:
+  explicit TargetColor(const LimitSurface& target,
+                       const Eigen::Vector3f& fallback = {0.8f, 0.8f, 0.8f});
+  Eigen::Vector3f operator()(const SurfacePoint& p) const;
+
+ private:
+  const LimitSurface* target_;
+  Eigen::Vector3f fallback_;
+  std::vector<Image> images_;  // one per control material (empty: none or unreadable)
+};
+
+/// The per-vertex colour mesh: region vertices (boundary included) carry the source colour
+/// blended over the target's own colour (TargetColor) by the source's alpha,
+/// rgb = alpha src + (1 - alpha) own, so a transparent texel shows the target; the others the
+/// target's own colour. `fallback` (default: the default material's grey, 0.8) colours a target
+/// without vertex colours, texture or material. Vertices without a source stay magenta.
 PolygonMesh make_colored_mesh(const PaintedSurface& painted, const ColorSource& source,
-                              const Eigen::Vector3f& outside = {0.5f, 0.5f, 0.5f});
+                              const Eigen::Vector3f& fallback = {0.8f, 0.8f, 0.8f});
 
 }  // namespace elastic
