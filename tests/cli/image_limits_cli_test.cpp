@@ -74,9 +74,10 @@ TEST(CliImageLimits, PngBombAsSourceImageIsRefusedAtOnce) {
   EXPECT_LT(run.seconds, 1.0);
   // Decoding would need 400 MB for the grey bytes alone (the issue measured 8.45 GB).
   EXPECT_LT(run.peak_mb, 100.0);
-  EXPECT_EQ(run.err.rfind("elastic: " + bomb.string() + ": image of 20000 x 20000 = 400000000 "
-                          "pixels is larger than the limit of 67108864 pixels; raise it with "
-                          "--max-image-pixels\n",
+  EXPECT_EQ(run.err.rfind("elastic: " + bomb.string() +
+                              ": image of 20000 x 20000 = 400000000 "
+                              "pixels is larger than the limit of 67108864 pixels; raise it with "
+                              "--max-image-pixels\n",
                           0),
             0u)
       << run.err;
@@ -87,9 +88,13 @@ TEST(CliImageLimits, FlagSetsTheLimit) {
   const fs::path dir = test::scratch_dir("cli_image_limit_flag");
   const fs::path image = dir / "small.png";
   test::write_zero_grey_png(image, 40, 25);  // 1000 pixels
-  const std::vector<std::string> base = {"map", "--source-image", image.string(), "--target",
+  const std::vector<std::string> base = {"map",
+                                         "--source-image",
+                                         image.string(),
+                                         "--target",
                                          test::project_mesh("cap_quads.obj").string(),
-                                         "--particles", "100"};
+                                         "--particles",
+                                         "100"};
   std::vector<std::string> lowered = base;
   lowered.insert(lowered.end(), {"--max-image-pixels", "999"});
   const MeasuredRun refused = run_measured(lowered, dir);

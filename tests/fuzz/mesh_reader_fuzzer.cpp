@@ -48,8 +48,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       result = detail::read_stl(bytes, name);
     } else if (format == "mtl") {
       const std::filesystem::path path = scratch_file(".mtl");
-      std::ofstream(path, std::ios::binary).write(bytes.data(),
-                                                  static_cast<std::streamsize>(bytes.size()));
+      std::ofstream(path, std::ios::binary)
+          .write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
       std::vector<Material> materials;
       detail::read_mtl(path, materials);
       return 0;
