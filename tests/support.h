@@ -19,6 +19,13 @@ inline std::filesystem::path shared_mesh(const std::string& name) {
   return std::filesystem::exists(path) ? path : std::filesystem::path();
 }
 
+/// A reproducer from ../shared/repro (small files the readers once mishandled; its README says
+/// what each did), or an empty path when that folder is not there.
+inline std::filesystem::path shared_repro(const std::string& name) {
+  const std::filesystem::path path = std::filesystem::path(ELASTIC_SHARED_REPRO_DIR) / name;
+  return std::filesystem::exists(path) ? path : std::filesystem::path();
+}
+
 /// A fresh, empty scratch directory for one test. It lives under a folder named after the running
 /// test (CTest runs tests in parallel processes, so tests must never share a scratch folder).
 inline std::filesystem::path scratch_dir(const std::string& name) {
@@ -38,3 +45,8 @@ inline std::filesystem::path scratch_dir(const std::string& name) {
 #define ELASTIC_REQUIRE_SHARED_MESH(var, name)                          \
   const std::filesystem::path var = ::elastic::test::shared_mesh(name); \
   if (var.empty()) GTEST_SKIP() << "../shared/meshes/" << (name) << " not present"
+
+/// Skips the current test when a reproducer is missing (../shared is optional for a clone).
+#define ELASTIC_REQUIRE_SHARED_REPRO(var, name)                          \
+  const std::filesystem::path var = ::elastic::test::shared_repro(name); \
+  if (var.empty()) GTEST_SKIP() << "../shared/repro/" << (name) << " not present"

@@ -102,6 +102,8 @@ void check_inputs(const PasteArgs& a) {
   if (!a.texture.empty() && !std::filesystem::exists(a.texture)) {
     throw IoError(a.texture, "no such file (--texture)");
   }
+  // Images are held to --max-image-pixels from their headers now, before any work.
+  if (!a.texture.empty()) read_image_info(a.texture, image_read_options(a.job));
   if (a.color == "texture" && a.job.source_image.empty() && a.texture.empty()) {
     const PolygonMesh source = read_mesh(a.job.source).mesh;
     if (!source.has_texcoords()) {
@@ -132,6 +134,7 @@ void check_inputs(const PasteArgs& a) {
     }
     if (!std::filesystem::exists(image))
       throw IoError(image.string(), "no such file (bake texture)");
+    read_image_info(image, image_read_options(a.job));
     if (same_file(image, std::filesystem::path(a.out) / "baked.png")) {
       throw UsageError("--out would overwrite the target's texture " + image.string() +
                        " with baked.png; choose another folder");
@@ -139,6 +142,9 @@ void check_inputs(const PasteArgs& a) {
   }
   if (!a.height.empty() && a.height != "luminance" && !std::filesystem::exists(a.height)) {
     throw IoError(a.height, "no such file (--height)");
+  }
+  if (!a.height.empty() && a.height != "luminance") {
+    read_image_info(a.height, image_read_options(a.job));
   }
   if (!a.detail.empty() && !std::filesystem::exists(a.detail)) {
     throw IoError(a.detail, "no such file (--detail)");
@@ -154,7 +160,7 @@ std::optional<ColorSource> make_color_source(const PasteArgs& a, const LimitSurf
   if (kind == "auto") {
     kind = texture_possible ? "texture" : mesh.has_vertex_colors() ? "vertex" : "none";
   }
-  if (kind == "texture") return ColorSource::texture(source, a.texture);
+  if (kind == "texture") return ColorSource::texture(source, a.texture, image_read_options(a.job));
   if (kind == "vertex") return ColorSource::vertex_colors(source);
   return std::nullopt;
 }
@@ -271,7 +277,8 @@ int run_paste(const PasteArgs& a, const CLI::App& sub) {
       bake.alpha = static_cast<float>(a.alpha);
       bake.feather = a.feather;
       bake.name = input.string();
-      const BakeResult baked = bake_texture(samples, target, *colors, read_image(input), bake);
+      const BakeResult baked = bake_texture(samples, target, *colors,
+                                            read_image(input, image_read_options(a.job)), bake);
       if (same_file(dir / "baked.png", input))
         throw UsageError("refusing to overwrite the input texture " + input.string());
       const std::filesystem::path out = folder.write_image("baked.png", baked.image);
@@ -305,7 +312,7 @@ int run_paste(const PasteArgs& a, const CLI::App& sub) {
       if (!source.control_mesh().has_texcoords()) {
         throw InvalidInputError(source.name(), "has no texture coordinates to look up --height");
       }
-      const Image image = read_image(a.height);
+      const Image image = read_image(a.height, image_read_options(a.job));
       std::vector<Eigen::Vector2d> uv;
       std::vector<int> index;
       for (int i = 0; i < samples.num_vertices(); ++i) {

@@ -41,6 +41,7 @@ struct RenderArgs {
   bool transparent = false;
   int threads = 0;
   bool quiet = false;
+  long long max_image_pixels = kDefaultMaxImagePixels;  ///< --max-image-pixels, for textures
 };
 
 /// "W", "WxH" (also "W*H" and "WXH") as positive pixel counts up to 16384.
@@ -76,12 +77,14 @@ int write_emblem(const RenderArgs& args) {
 
 /// Reads a mesh for drawing: colours and materials as the file has them; texture files that cannot
 /// be read become warnings (the faces then show their material colour).
-SceneObject load_object(const std::string& path, std::vector<std::string>& warnings) {
+SceneObject load_object(const std::string& path, const RenderArgs& args,
+                        std::vector<std::string>& warnings) {
   MeshReadResult read = read_mesh(path);
   for (const std::string& w : read.warnings) warnings.push_back(path + ": " + w);
   SceneObject object{std::move(read.mesh), {}};
   if (object.mesh.has_texcoords() && !object.mesh.materials.empty()) {
-    MaterialTextures textures = load_material_textures(object.mesh);
+    MaterialTextures textures = load_material_textures(
+        object.mesh, {.max_pixels = args.max_image_pixels, .limit_name = "--max-image-pixels"});
     warnings.insert(warnings.end(), textures.warnings.begin(), textures.warnings.end());
     object.look.textures = std::move(textures.images);
   }
@@ -98,7 +101,7 @@ int run_render(const RenderArgs& args) {
   std::vector<std::string> warnings;
   Scene scene;
   for (const std::string& path : args.meshes) {
-    scene.objects.push_back(load_object(path, warnings));
+    scene.objects.push_back(load_object(path, args, warnings));
     ObjectLook& look = scene.objects.back().look;
     if (args.heatmap) {
       if (!scene.objects.back().mesh.has_face_colors()) {
@@ -109,7 +112,7 @@ int run_render(const RenderArgs& args) {
     look.wireframe = args.edges;
   }
   if (!args.wireframe.empty()) {
-    SceneObject grid = load_object(args.wireframe, warnings);
+    SceneObject grid = load_object(args.wireframe, args, warnings);
     grid.look.surface = false;
     grid.look.wireframe = true;
     scene.objects.push_back(std::move(grid));
@@ -202,6 +205,10 @@ ELASTIC_COMMAND(
       sub.add_flag("--transparent", args->transparent, "Transparent background");
       sub.add_option("--threads", args->threads, "Threads (0: all); the image does not change")
           ->check(CLI::Range(0, 1024))
+          ->capture_default_str();
+      sub.add_option("--max-image-pixels", args->max_image_pixels,
+                     "Skip textures with more pixels (width x height), checked before decoding")
+          ->check(CLI::PositiveNumber)
           ->capture_default_str();
       sub.add_flag("--quiet", args->quiet, "Print nothing but errors");
       sub.footer(

@@ -1,14 +1,45 @@
 // The `elastic` command-line tool. Library errors become one line on stderr and a documented exit
 // code.
 
+#include <signal.h>
+
 #include <cstdio>
 #include <exception>
 #include <iostream>
 #include <memory>
 
 #include "command.h"
+#include "elastic/core/atomic_file.h"
 #include "elastic/core/error.h"
 #include "job_file.h"
+
+namespace {
+
+/// On SIGINT, SIGTERM or SIGHUP: remove the temporary files being written (async-signal-safe),
+/// then die of the same signal, so the parent sees the usual status. Finished files are never
+/// touched: each was renamed into place whole, and every destination keeps its old content until
+/// its rename.
+extern "C" void remove_temporaries_and_reraise(int signal_number) {
+  elastic::remove_temporary_files_now();
+  ::signal(signal_number, SIG_DFL);
+  ::raise(signal_number);
+}
+
+void install_interrupt_handlers() {
+  struct sigaction action {};
+  action.sa_handler = remove_temporaries_and_reraise;
+  sigemptyset(&action.sa_mask);
+  for (const int signal_number : {SIGINT, SIGTERM, SIGHUP}) {
+    // A signal the parent asked us to ignore (nohup, a background job) stays ignored.
+    struct sigaction previous {};
+    if (::sigaction(signal_number, nullptr, &previous) == 0 && previous.sa_handler == SIG_IGN) {
+      continue;
+    }
+    ::sigaction(signal_number, &action, nullptr);
+  }
+}
+
+}  // namespace
 
 namespace elastic::cli {
 std::vector<Command>& command_registry() {
@@ -19,6 +50,7 @@ std::vector<Command>& command_registry() {
 
 int main(int argc, char** argv) {
   using namespace elastic::cli;
+  install_interrupt_handlers();
   CLI::App app{
       "ElasticPaint: paste features from a region of one surface onto another with least "
       "distortion"};

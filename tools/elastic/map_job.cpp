@@ -61,6 +61,9 @@ void add_map_flags(CLI::App& sub, MapJob& a) {
                  "Source image (PNG, JPEG, ...) on a plane; region: rectangle or ellipse");
   sub.add_option("--image-width", a.image_width, "Physical width of the source image's plane")
       ->check(CLI::PositiveNumber);
+  sub.add_option("--max-image-pixels", a.max_image_pixels,
+                 "Refuse images with more pixels (width x height), checked before decoding")
+      ->check(CLI::PositiveNumber);
   sub.add_option("--source-region", a.source_region,
                  "Source region: disk:X,Y,Z,R | points:FILE | boundary | uv:FILE");
   sub.add_option("--source-anchor", a.source_anchor, "X,Y,Z: start of the boundary correspondence");
@@ -138,10 +141,12 @@ std::unique_ptr<MapSession> run_map_job(const MapJob& job, const ProgressCallbac
           "--source-region", "with --source-image it is 'rectangle' (default) or 'ellipse', got '" +
                                  job.source_region + "'");
     }
-    s.image = make_image_plane(
-        job.source_image, {.width = job.image_width,
-                           .shape = job.source_region == "ellipse" ? ImageRegionShape::Ellipse
-                                                                   : ImageRegionShape::Rectangle});
+    s.image =
+        make_image_plane(job.source_image,
+                         {.width = job.image_width,
+                          .shape = job.source_region == "ellipse" ? ImageRegionShape::Ellipse
+                                                                  : ImageRegionShape::Rectangle},
+                         image_read_options(job));
   }
   if (progress) progress({.stage = "load"});
   s.source = s.image ? surface_from_mesh(s.image->mesh, job.source_image, job.scheme)

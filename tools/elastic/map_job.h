@@ -45,7 +45,15 @@ struct MapJob {
   long max_iterations = 0;                   ///< --max-iterations (0: the solver's default)
   std::string report;                        ///< --report FILE
   bool quiet = false;                        ///< --quiet
+
+  /// --max-image-pixels: the most pixels any image the job reads may have (checked from headers)
+  long long max_image_pixels = kDefaultMaxImagePixels;
 };
+
+/// The limits every image the job reads is held to (--max-image-pixels).
+inline ImageReadOptions image_read_options(const MapJob& job) {
+  return {.max_pixels = job.max_image_pixels, .limit_name = "--max-image-pixels"};
+}
 
 /// Adds the MapJob flags to a subcommand (--report and --quiet included).
 void add_map_flags(CLI::App& sub, MapJob& job);

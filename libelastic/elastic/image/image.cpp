@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <fstream>
 #include <memory>
 #include <string>
@@ -59,27 +60,50 @@ Eigen::Vector4f sample(const Image& image, const Eigen::Vector2d& uv, ImageWrap 
   return (1.0f - ty) * top + ty * bottom;
 }
 
-Image read_image(const std::filesystem::path& path) {
+namespace {
+
+/// stb's reason for the last failure (it may have none).
+std::string stb_reason() {
+  const char* reason = stbi_failure_reason();
+  return reason != nullptr && *reason != '\0' ? reason : "unknown reason";
+}
+
+}  // namespace
+
+ImageInfo read_image_info(const std::filesystem::path& path, const ImageReadOptions& options) {
   const std::string name = path.string();
+  if (!(options.max_pixels > 0)) {
+    throw InvalidInputError(options.limit_name,
+                            "must be positive, got " + std::to_string(options.max_pixels));
+  }
   if (!std::ifstream(path, std::ios::binary)) {
     throw IoError(name, "cannot open the image");
   }
+  ImageInfo info;
+  if (!stbi_info(name.c_str(), &info.width, &info.height, &info.channels) || info.width <= 0 ||
+      info.height <= 0) {
+    throw InvalidInputError(name, "not a readable image (" + stb_reason() + ")");
+  }
+  const std::int64_t pixels = std::int64_t{info.width} * std::int64_t{info.height};
+  if (pixels > options.max_pixels) {
+    throw InvalidInputError(name, "image of " + std::to_string(info.width) + " x " +
+                                      std::to_string(info.height) + " = " + std::to_string(pixels) +
+                                      " pixels is larger than the limit of " +
+                                      std::to_string(options.max_pixels) +
+                                      " pixels; raise it with " + options.limit_name);
+  }
+  return info;
+}
+
+Image read_image(const std::filesystem::path& path, const ImageReadOptions& options) {
+  const std::string name = path.string();
+  // The size comes from the header, before stb allocates anything for the pixels.
+  read_image_info(path, options);
   int columns = 0, rows = 0, channels = 0;
-  if (!stbi_info(name.c_str(), &columns, &rows, &channels) || columns <= 0 || rows <= 0) {
-    throw InvalidInputError(name,
-                            std::string("not a readable image (") + stbi_failure_reason() + ")");
-  }
-  constexpr int kMaxSide = 32768;
-  if (columns > kMaxSide || rows > kMaxSide) {
-    throw InvalidInputError(name, "image of " + std::to_string(columns) + " x " +
-                                      std::to_string(rows) + " pixels is larger than " +
-                                      std::to_string(kMaxSide) + " on a side");
-  }
   const std::unique_ptr<stbi_uc, void (*)(void*)> data(
       stbi_load(name.c_str(), &columns, &rows, &channels, 4), stbi_image_free);
   if (!data) {
-    throw InvalidInputError(name,
-                            std::string("not a readable image (") + stbi_failure_reason() + ")");
+    throw InvalidInputError(name, "not a readable image (" + stb_reason() + ")");
   }
   Image image(columns, rows);
   const stbi_uc* p = data.get();

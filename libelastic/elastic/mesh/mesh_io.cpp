@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cerrno>
+#include <cmath>
 #include <cstring>
 #include <fstream>
 
@@ -74,6 +75,33 @@ void check_writable(const PolygonMesh& mesh, const std::filesystem::path& path) 
   for (int v = 0; v < nv; ++v) {
     if (!mesh.positions[static_cast<size_t>(v)].allFinite()) {
       fail("vertex " + std::to_string(v) + " has a NaN or infinite coordinate");
+    }
+  }
+  auto check_finite = [&](const auto& pool, const char* what) {
+    for (size_t i = 0; i < pool.size(); ++i) {
+      if (!pool[i].allFinite()) {
+        fail(std::string(what) + " " + std::to_string(i) + " is NaN or infinite");
+      }
+    }
+  };
+  check_finite(mesh.texcoords, "texture coordinate");
+  check_finite(mesh.normals, "normal");
+  check_finite(mesh.vertex_colors, "vertex colour");
+  check_finite(mesh.face_colors, "face colour");
+  for (const Material& m : mesh.materials) {
+    if (!m.diffuse.allFinite()) {
+      fail("material '" + m.name + "' has a NaN or infinite diffuse colour");
+    }
+  }
+  for (const Crease& c : mesh.creases) {
+    if (!std::isfinite(c.sharpness)) {
+      fail("crease " + std::to_string(c.v0) + "-" + std::to_string(c.v1) +
+           " has a NaN or infinite sharpness");
+    }
+  }
+  for (const auto& [v, sharpness] : mesh.corners) {
+    if (!std::isfinite(sharpness)) {
+      fail("corner " + std::to_string(v) + " has a NaN or infinite sharpness");
     }
   }
   auto check_corners = [&](const std::vector<int>& corners, size_t pool, const char* what) {
@@ -209,6 +237,7 @@ void write_mesh(const std::filesystem::path& path, const PolygonMesh& mesh,
       binary = options.binary;
       break;
     case MeshFormat::Stl:
+      detail::check_stl_writable(mesh, path);
       bytes = detail::write_stl(mesh, options);
       binary = options.binary;
       break;

@@ -73,6 +73,9 @@ bool read_mtl(const std::filesystem::path& path, std::vector<Material>& material
       for (int k = 0; k < 3; ++k) {
         current->diffuse[k] = expect_double(rest, scanner, "Kd value");
       }
+      if (!current->diffuse.allFinite()) {
+        scanner.fail("Kd value is NaN or infinite");
+      }
     } else if (keyword == "map_Kd") {
       std::string file(texture_file(rest));
       if (file.empty()) {

@@ -1,6 +1,8 @@
 // Wavefront OBJ: reading (v, vt, vn, f, mtllib, usemtl, OpenSubdiv `t` tags, `v x y z r g b`
 // colours) and writing.
 
+#include <cmath>
+#include <limits>
 #include <set>
 #include <unordered_map>
 
@@ -52,6 +54,9 @@ ObjTag parse_tag(std::string_view rest, const LineScanner& scanner) {
   }
   for (long long i = 0; i < n[1]; ++i) {
     tag.floats.push_back(expect_double(rest, scanner, "tag value"));
+    if (!std::isfinite(tag.floats.back())) {
+      scanner.fail("tag value is NaN or infinite");
+    }
   }
   return tag;
 }
@@ -132,6 +137,12 @@ MeshReadResult read_obj(const std::string& text, const std::filesystem::path& pa
         ++n_extra;
       }
       if (n_extra >= 3) {
+        for (int k = 0; k < 3; ++k) {
+          // Colours are stored as float: finite there, or the file is refused.
+          if (!(std::fabs(extra[k]) <= static_cast<double>(std::numeric_limits<float>::max()))) {
+            scanner.fail("vertex colour is NaN, infinite or beyond float range");
+          }
+        }
         colors.resize(mesh.positions.size(), Eigen::Vector3f::Ones());
         colors.back() = Eigen::Vector3f(static_cast<float>(extra[0]), static_cast<float>(extra[1]),
                                         static_cast<float>(extra[2]));

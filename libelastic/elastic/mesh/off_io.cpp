@@ -2,6 +2,8 @@
 // CRLF.
 
 #include <algorithm>
+#include <cmath>
+#include <limits>
 
 #include "elastic/mesh/detail/io_common.h"
 
@@ -81,11 +83,13 @@ MeshReadResult read_off(const std::string& text, const std::filesystem::path& pa
   if (nv < 0 || nf < 0 || nv > 2147483647LL || nf > 2147483647LL) {
     scanner.fail("invalid counts");
   }
-  // Counts come from the file: reserve no more than its size could hold.
-  const auto bound = static_cast<long long>(text.size() / 6 + 1);
-  mesh.positions.reserve(static_cast<size_t>(std::min(nv, bound)));
+  // Counts come from the file: a vertex line holds at least "0 0 0\n" (6 bytes) and a face line
+  // "3 0 1 2\n" (8 bytes), so nothing is reserved beyond what the remaining bytes can hold. The
+  // loops below read at least one line per vertex or face and report a short file with the counts.
+  const auto remaining = static_cast<long long>(text.size() - scanner.position());
+  mesh.positions.reserve(static_cast<size_t>(std::min(nv, remaining / 6 + 1)));
   if (has_color) {
-    mesh.vertex_colors.reserve(static_cast<size_t>(std::min(nv, bound)));
+    mesh.vertex_colors.reserve(static_cast<size_t>(std::min(nv, remaining / 6 + 1)));
   }
 
   std::vector<double> values;
@@ -108,6 +112,9 @@ MeshReadResult read_off(const std::string& text, const std::filesystem::path& pa
       for (int k = 0; k < 3; ++k) {
         n[k] = expect_double(rest, scanner, "normal coordinate");
       }
+      if (!n.allFinite()) {
+        scanner.fail("vertex has a NaN or infinite normal");
+      }
       mesh.normals.push_back(n);
     }
     // The rest: colour (3 or 4 values, integers 0..255 or reals 0..1), then s t when ST.
@@ -127,7 +134,11 @@ MeshReadResult read_off(const std::string& text, const std::filesystem::path& pa
         scanner.fail("missing texture coordinates");
       }
       uv_at = tokens.size() - 2;
-      mesh.texcoords.emplace_back(values[uv_at], values[uv_at + 1]);
+      const Eigen::Vector2d uv(values[uv_at], values[uv_at + 1]);
+      if (!uv.allFinite()) {
+        scanner.fail("vertex has a NaN or infinite texture coordinate");
+      }
+      mesh.texcoords.push_back(uv);
     }
     if (has_color) {
       if (uv_at < 3) {
@@ -136,13 +147,21 @@ MeshReadResult read_off(const std::string& text, const std::filesystem::path& pa
       const bool bytes =
           looks_integer(tokens[0]) && looks_integer(tokens[1]) && looks_integer(tokens[2]);
       const double scale = bytes ? 1.0 / 255.0 : 1.0;
+      for (int k = 0; k < 3; ++k) {
+        // Stored as float: a colour must be finite there.
+        if (!(std::fabs(values[k] * scale) <=
+              static_cast<double>(std::numeric_limits<float>::max()))) {
+          scanner.fail("vertex colour '" + std::string(tokens[static_cast<size_t>(k)]) +
+                       "' is NaN, infinite or beyond float range");
+        }
+      }
       mesh.vertex_colors.emplace_back(static_cast<float>(values[0] * scale),
                                       static_cast<float>(values[1] * scale),
                                       static_cast<float>(values[2] * scale));
     }
   }
 
-  mesh.face_offsets.reserve(static_cast<size_t>(std::min(nf, bound)) + 1);
+  mesh.face_offsets.reserve(static_cast<size_t>(std::min(nf, remaining / 8 + 1)) + 1);
   mesh.face_offsets.push_back(0);
   for (long long f = 0; f < nf; ++f) {
     if (!next_content_line(scanner, content)) {

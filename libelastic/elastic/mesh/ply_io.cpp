@@ -6,7 +6,9 @@
 #include <algorithm>
 #include <array>
 #include <bit>
+#include <cmath>
 #include <cstring>
+#include <limits>
 #include <unordered_map>
 
 #include "elastic/mesh/detail/io_common.h"
@@ -85,8 +87,80 @@ struct PlyElement {
 
 enum class PlyEncoding { Ascii, BinaryLittle, BinaryBig };
 
+/// The name of a type as the header writes it (for messages).
+const char* type_name(PlyType type) {
+  switch (type) {
+    case PlyType::Int8:
+      return "char";
+    case PlyType::UInt8:
+      return "uchar";
+    case PlyType::Int16:
+      return "short";
+    case PlyType::UInt16:
+      return "ushort";
+    case PlyType::Int32:
+      return "int";
+    case PlyType::UInt32:
+      return "uint";
+    case PlyType::Float32:
+      return "float";
+    case PlyType::Float64:
+      return "double";
+  }
+  return "?";
+}
+
+/// The range of values a type holds; an ASCII value outside it is refused, so that an ASCII file
+/// holds nothing its binary twin could not (and no value is later converted out of range).
+void type_range(PlyType type, double& lo, double& hi) {
+  switch (type) {
+    case PlyType::Int8:
+      lo = -128.0, hi = 127.0;
+      return;
+    case PlyType::UInt8:
+      lo = 0.0, hi = 255.0;
+      return;
+    case PlyType::Int16:
+      lo = -32768.0, hi = 32767.0;
+      return;
+    case PlyType::UInt16:
+      lo = 0.0, hi = 65535.0;
+      return;
+    case PlyType::Int32:
+      lo = -2147483648.0, hi = 2147483647.0;
+      return;
+    case PlyType::UInt32:
+      lo = 0.0, hi = 4294967295.0;
+      return;
+    case PlyType::Float32:
+      lo = -static_cast<double>(std::numeric_limits<float>::max());
+      hi = static_cast<double>(std::numeric_limits<float>::max());
+      return;
+    case PlyType::Float64:
+      lo = -std::numeric_limits<double>::max();
+      hi = std::numeric_limits<double>::max();
+      return;
+  }
+}
+
+/// Fewest bytes one row of `element` occupies: in binary, its scalars and list counts (a list may
+/// be empty); in ASCII, one token and one separator per property. Zero for an element without
+/// properties, whose rows hold nothing in either encoding.
+size_t min_row_bytes(const PlyElement& element, PlyEncoding encoding) {
+  size_t bytes = 0;
+  for (const PlyProperty& property : element.properties) {
+    if (encoding == PlyEncoding::Ascii) {
+      bytes += 2;
+    } else {
+      bytes += type_size(property.is_list ? property.count_type : property.type);
+    }
+  }
+  return bytes;
+}
+
 /// Reads the values of the data section one at a time, in any of the three encodings, reporting
-/// errors with the element and row they occurred in.
+/// errors with the element and row they occurred in. Every value is checked against its declared
+/// type; integers (list lengths, indices) are checked to be whole numbers before any conversion.
 class PlyData {
  public:
   PlyData(std::string_view data, PlyEncoding encoding, const std::filesystem::path& path,
@@ -99,14 +173,35 @@ class PlyData {
     rows_ = rows;
   }
 
+  /// Bytes not read yet.
+  size_t remaining() const { return data_.size() - pos_; }
+
+  /// Refuses an element whose declared rows cannot fit in the bytes that remain (so a count in the
+  /// header never costs more time or memory than the file's size).
+  void check_element_fits(const PlyElement& element) const {
+    const size_t row_bytes = min_row_bytes(element, encoding_);
+    if (row_bytes == 0) {
+      return;
+    }
+    // In ASCII the last token of the file needs no separator after it.
+    const size_t available = remaining() + (encoding_ == PlyEncoding::Ascii ? 1 : 0);
+    if (static_cast<unsigned long long>(element.count) > available / row_bytes) {
+      throw InvalidInputError(path_.string(),
+                              "truncated file: element '" + element.name + "' declares " +
+                                  std::to_string(element.count) + " rows of at least " +
+                                  std::to_string(row_bytes) + " bytes, but only " +
+                                  std::to_string(remaining()) + " bytes of data remain");
+    }
+  }
+
+  /// A value of the declared type (as a double, which holds every PLY type exactly).
   double read(PlyType type) {
     if (encoding_ == PlyEncoding::Ascii) {
-      return read_ascii();
+      return read_ascii(type);
     }
     const size_t size = type_size(type);
     if (pos_ + size > data_.size()) {
-      fail("truncated file: the binary data ends in element '" + *element_ + "' row " +
-           std::to_string(row_ + 1) + " of " + std::to_string(rows_));
+      fail("truncated file: the binary data ends in " + where());
     }
     unsigned char bytes[8];
     std::memcpy(bytes, data_.data() + pos_, size);
@@ -137,6 +232,42 @@ class PlyData {
     return 0.0;
   }
 
+  /// A value that must be a whole number (a list length or an index, possibly stored in a float
+  /// type): NaN, infinities and fractions are refused before the conversion to an integer.
+  long long read_integer(PlyType type, const std::string& what) {
+    const double value = read(type);
+    // 2^62 is far beyond any count a file can back and well inside long long.
+    if (!std::isfinite(value) || value != std::floor(value) || std::fabs(value) > 0x1p62) {
+      fail(what + " in " + where() + " is " + number_text(value) + ", not a whole number");
+    }
+    return static_cast<long long>(value);
+  }
+
+  /// A list length: whole, not negative, and no more items than the remaining bytes can hold.
+  long long read_list_length(const PlyProperty& property) {
+    const long long n =
+        read_integer(property.count_type, "the length of list '" + property.name + "'");
+    if (n < 0) {
+      fail("negative length " + std::to_string(n) + " of list '" + property.name + "' in " +
+           where());
+    }
+    const unsigned long long item_bytes =
+        encoding_ == PlyEncoding::Ascii ? 2 : type_size(property.type);
+    const size_t available = remaining() + (encoding_ == PlyEncoding::Ascii ? 1 : 0);
+    if (static_cast<unsigned long long>(n) > available / item_bytes) {
+      fail("truncated file: list '" + property.name + "' in " + where() + " has " +
+           std::to_string(n) + " items, more than the remaining " + std::to_string(remaining()) +
+           " bytes hold");
+    }
+    return n;
+  }
+
+  /// "element 'face' row 3 of 10" (1-based row).
+  std::string where() const {
+    return "element '" + *element_ + "' row " + std::to_string(row_ + 1) + " of " +
+           std::to_string(rows_);
+  }
+
   [[noreturn]] void fail(const std::string& problem) const {
     if (encoding_ == PlyEncoding::Ascii) {
       throw InvalidInputError(path_.string(), "line " + std::to_string(line_) + ": " + problem);
@@ -152,7 +283,13 @@ class PlyData {
     return value;
   }
 
-  double read_ascii() {
+  static std::string number_text(double value) {
+    std::string text;
+    append_number(text, value);
+    return text;
+  }
+
+  double read_ascii(PlyType type) {
     while (pos_ < data_.size() && (is_space(data_[pos_]) || data_[pos_] == '\n')) {
       if (data_[pos_] == '\n') {
         ++line_;
@@ -160,8 +297,7 @@ class PlyData {
       ++pos_;
     }
     if (pos_ >= data_.size()) {
-      fail("truncated file: it ends in element '" + *element_ + "' row " +
-           std::to_string(row_ + 1) + " of " + std::to_string(rows_));
+      fail("truncated file: it ends in " + where());
     }
     size_t end = pos_;
     while (end < data_.size() && !is_space(data_[end]) && data_[end] != '\n') {
@@ -172,6 +308,20 @@ class PlyData {
     double value = 0.0;
     if (!parse_double(token, value)) {
       fail("cannot parse number '" + std::string(token) + "'");
+    }
+    double lo = 0.0;
+    double hi = 0.0;
+    type_range(type, lo, hi);
+    if (is_float_type(type)) {
+      // NaN and infinities are values of a float type; the caller decides whether to keep them.
+      if (std::isfinite(value) && (value < lo || value > hi)) {
+        fail("value " + std::string(token) + " in " + where() + " is beyond the range of " +
+             type_name(type));
+      }
+    } else if (!(value >= lo && value <= hi) || value != std::floor(value)) {
+      fail("value " + std::string(token) + " in " + where() +
+           " is not a whole number in the range of " + type_name(type) + " [" + number_text(lo) +
+           ", " + number_text(hi) + "]");
     }
     return value;
   }
@@ -298,7 +448,7 @@ MeshReadResult read_ply(const std::string& text, const std::filesystem::path& pa
 
   PlyData data(std::string_view(text).substr(scanner.position()), encoding, path,
                scanner.line_number() + 1);
-  const auto bound = static_cast<long long>(text.size() / 3 + 1);
+  constexpr long long kMaxInt = std::numeric_limits<int>::max();
   bool seen_vertices = false;
   bool have_uv = false;
   bool have_normal = false;
@@ -306,9 +456,36 @@ MeshReadResult read_ply(const std::string& text, const std::filesystem::path& pa
   bool have_corner_uv = false;
   std::vector<int> corner_uv;
   long long num_vertices = 0;
+  // A colour channel as the mesh stores it (float): finite, or the file is refused.
+  auto color_channel = [&](double value, double scale, long long row, const char* what) {
+    const double c = value * scale;
+    if (!(std::fabs(c) <= static_cast<double>(std::numeric_limits<float>::max()))) {
+      data.fail(std::string(what) + " " + std::to_string(row) + " has a colour beyond float range");
+    }
+    return static_cast<float>(c);
+  };
   for (const PlyElement& element : elements) {
+    if (min_row_bytes(element, encoding) == 0) {
+      // Rows without properties hold no bytes in either encoding: nothing to read or skip, however
+      // many the header declares.
+      if (element.count > 0) {
+        result.warnings.push_back(path.string() + ": element '" + element.name + "' has " +
+                                  std::to_string(element.count) +
+                                  " rows but no properties; skipped");
+      }
+      if (element.name == "vertex" && !seen_vertices && element.count > 0) {
+        throw InvalidInputError(path.string(), "the vertex element has no x, y and z properties");
+      }
+      continue;
+    }
+    data.check_element_fits(element);
     if (element.name == "vertex" && !seen_vertices) {
       seen_vertices = true;
+      if (element.count > kMaxInt) {
+        throw InvalidInputError(path.string(), std::to_string(element.count) +
+                                                   " vertices: more than the library indexes (" +
+                                                   std::to_string(kMaxInt) + ")");
+      }
       num_vertices = element.count;
       std::vector<int> role(element.properties.size());
       bool has_role[kNumRoles] = {};
@@ -330,8 +507,8 @@ MeshReadResult read_ply(const std::string& text, const std::filesystem::path& pa
       have_normal = has_role[kNx] && has_role[kNy] && has_role[kNz];
       have_color = has_role[kRed] && has_role[kGreen] && has_role[kBlue];
       have_uv = has_role[kU] && has_role[kV];
-      const auto reserve = static_cast<size_t>(std::min(element.count, bound));
-      mesh.positions.reserve(reserve);
+      // check_element_fits bounded the count by the file's size.
+      mesh.positions.reserve(static_cast<size_t>(element.count));
       double values[kNumRoles];
       for (long long row = 0; row < element.count; ++row) {
         data.locate(element.name, row, element.count);
@@ -339,8 +516,8 @@ MeshReadResult read_ply(const std::string& text, const std::filesystem::path& pa
         for (size_t p = 0; p < element.properties.size(); ++p) {
           const PlyProperty& property = element.properties[p];
           if (property.is_list) {
-            const double n = data.read(property.count_type);
-            for (long long k = 0; k < static_cast<long long>(n); ++k) {
+            const long long n = data.read_list_length(property);
+            for (long long k = 0; k < n; ++k) {
               data.read(property.type);
             }
             continue;
@@ -356,18 +533,33 @@ MeshReadResult read_ply(const std::string& text, const std::filesystem::path& pa
         }
         mesh.positions.push_back(position);
         if (have_normal) {
-          mesh.normals.emplace_back(values[kNx], values[kNy], values[kNz]);
+          const Eigen::Vector3d normal(values[kNx], values[kNy], values[kNz]);
+          if (!normal.allFinite()) {
+            data.fail("vertex " + std::to_string(row) + " has a NaN or infinite normal");
+          }
+          mesh.normals.push_back(normal);
         }
         if (have_color) {
-          mesh.vertex_colors.emplace_back(static_cast<float>(values[kRed] * scale[kRed]),
-                                          static_cast<float>(values[kGreen] * scale[kGreen]),
-                                          static_cast<float>(values[kBlue] * scale[kBlue]));
+          mesh.vertex_colors.emplace_back(
+              color_channel(values[kRed], scale[kRed], row, "vertex"),
+              color_channel(values[kGreen], scale[kGreen], row, "vertex"),
+              color_channel(values[kBlue], scale[kBlue], row, "vertex"));
         }
         if (have_uv) {
-          mesh.texcoords.emplace_back(values[kU], values[kV]);
+          const Eigen::Vector2d uv(values[kU], values[kV]);
+          if (!uv.allFinite()) {
+            data.fail("vertex " + std::to_string(row) +
+                      " has a NaN or infinite texture coordinate");
+          }
+          mesh.texcoords.push_back(uv);
         }
       }
     } else if (element.name == "face" && mesh.face_offsets.empty()) {
+      if (element.count > kMaxInt) {
+        throw InvalidInputError(path.string(), std::to_string(element.count) +
+                                                   " faces: more than the library indexes (" +
+                                                   std::to_string(kMaxInt) + ")");
+      }
       int indices_property = -1;
       int texcoord_property = -1;
       for (size_t p = 0; p < element.properties.size(); ++p) {
@@ -387,7 +579,7 @@ MeshReadResult read_ply(const std::string& text, const std::filesystem::path& pa
                                 "the face element has no vertex_indices / vertex_index list");
       }
       have_corner_uv = texcoord_property >= 0;
-      mesh.face_offsets.reserve(static_cast<size_t>(std::min(element.count, bound)) + 1);
+      mesh.face_offsets.reserve(static_cast<size_t>(element.count) + 1);
       mesh.face_offsets.push_back(0);
       // Optional per-face colour (red green blue scalars on the face element).
       std::array<int, 3> face_color_property{-1, -1, -1};
@@ -419,16 +611,12 @@ MeshReadResult read_ply(const std::string& text, const std::filesystem::path& pa
             const double value = data.read(property.type);
             for (int k = 0; k < 3; ++k) {
               if (face_color_property[static_cast<size_t>(k)] == static_cast<int>(p)) {
-                face_color[k] = static_cast<float>(value * color_scale(property.type));
+                face_color[k] = color_channel(value, color_scale(property.type), row, "face");
               }
             }
             continue;
           }
-          const double count = data.read(property.count_type);
-          if (count < 0) {
-            data.fail("negative list length in face " + std::to_string(row));
-          }
-          const auto n = static_cast<long long>(count);
+          const long long n = data.read_list_length(property);
           if (static_cast<int>(p) == indices_property) {
             corners = n;
             if (n < 3) {
@@ -436,18 +624,25 @@ MeshReadResult read_ply(const std::string& text, const std::filesystem::path& pa
                         " corners (at least 3)");
             }
             for (long long k = 0; k < n; ++k) {
-              const double i = data.read(property.type);
-              if (!(i >= 0 && i < static_cast<double>(num_vertices)) || !seen_vertices) {
-                data.fail("face " + std::to_string(row) + ": vertex index " +
-                          std::to_string(static_cast<long long>(i)) + " out of range (" +
-                          std::to_string(num_vertices) + " vertices)");
+              const long long i = data.read_integer(property.type, "a vertex index");
+              if (i < 0 || i >= num_vertices || !seen_vertices) {
+                data.fail("face " + std::to_string(row) + ": vertex index " + std::to_string(i) +
+                          " out of range (" + std::to_string(num_vertices) + " vertices)");
               }
               mesh.face_vertices.push_back(static_cast<int>(i));
+            }
+            if (mesh.face_vertices.size() > static_cast<size_t>(kMaxInt)) {
+              data.fail("more face corners than the library indexes");
             }
           } else if (static_cast<int>(p) == texcoord_property) {
             uv_values.clear();
             for (long long k = 0; k < n; ++k) {
-              uv_values.push_back(data.read(property.type));
+              const double value = data.read(property.type);
+              if (!std::isfinite(value)) {
+                data.fail("face " + std::to_string(row) +
+                          " has a NaN or infinite texture coordinate");
+              }
+              uv_values.push_back(value);
             }
           } else {
             for (long long k = 0; k < n; ++k) {
@@ -477,12 +672,13 @@ MeshReadResult read_ply(const std::string& text, const std::filesystem::path& pa
         mesh.face_offsets.clear();
       }
     } else {
-      // Skip other elements (edges, materials, a second vertex element...) by their declared types.
+      // Skip other elements (edges, materials, a second vertex element...) by their declared
+      // types. check_element_fits bounded the rows by the file's size, and every row reads at
+      // least one byte, so skipping costs time in proportion to the file.
       for (long long row = 0; row < element.count; ++row) {
         data.locate(element.name, row, element.count);
         for (const PlyProperty& property : element.properties) {
-          const long long n =
-              property.is_list ? static_cast<long long>(data.read(property.count_type)) : 1;
+          const long long n = property.is_list ? data.read_list_length(property) : 1;
           for (long long k = 0; k < n; ++k) {
             data.read(property.type);
           }

@@ -6,6 +6,7 @@
 #include <bit>
 #include <cstdint>
 #include <cstring>
+#include <limits>
 #include <unordered_map>
 
 #include "elastic/mesh/detail/io_common.h"
@@ -48,6 +49,11 @@ class Welder {
   PolygonMesh& mesh_;
   std::unordered_map<PositionKey, int, PositionHash> index_;
 };
+
+/// Whether every coordinate is within float's range (what an STL file can hold).
+bool fits_float(const Eigen::Vector3d& p) {
+  return p.cwiseAbs().maxCoeff() <= static_cast<double>(std::numeric_limits<float>::max());
+}
 
 std::uint32_t read_u32_le(const char* p) {
   unsigned char b[4];
@@ -126,10 +132,20 @@ MeshReadResult read_ascii_stl(const std::string& text, const std::filesystem::pa
       if (!p.allFinite()) {
         scanner.fail("vertex has a NaN or infinite coordinate");
       }
+      if (!fits_float(p)) {
+        // STL stores 32-bit floats: such a vertex has no binary STL form and would be written
+        // as an infinity that does not read back.
+        scanner.fail("vertex coordinate beyond the range of float (about 3.4e38)");
+      }
       loop.push_back(welder.vertex(p));
     } else if (keyword == "outer") {
+      if (in_loop) {
+        scanner.fail("'outer loop' inside a loop: the facet before it has no 'endloop'");
+      }
       in_loop = true;
       loop.clear();
+    } else if (in_loop && (keyword == "endfacet" || keyword == "facet" || keyword == "endsolid")) {
+      scanner.fail("'" + std::string(keyword) + "' inside a loop: the facet has no 'endloop'");
     } else if (keyword == "endloop") {
       if (!in_loop) {
         scanner.fail("'endloop' without 'outer loop'");
@@ -192,6 +208,24 @@ MeshReadResult read_stl(const std::string& text, const std::filesystem::path& pa
   return read_binary_stl(text, path);
 }
 
+void check_stl_writable(const PolygonMesh& mesh, const std::filesystem::path& path) {
+  std::size_t triangles = 0;
+  for (int f = 0; f < mesh.num_faces(); ++f) {
+    triangles += static_cast<size_t>(mesh.face_size(f) - 2);
+    for (const int v : mesh.face(f)) {
+      if (!fits_float(mesh.positions[static_cast<size_t>(v)])) {
+        throw InvalidInputError(path.string(), "vertex " + std::to_string(v) +
+                                                   " is beyond the range of float (about 3.4e38), "
+                                                   "which STL stores");
+      }
+    }
+  }
+  if (triangles > 0xffffffffULL) {
+    throw InvalidInputError(path.string(), "too many triangles for STL (" +
+                                               std::to_string(triangles) + ", at most 2^32 - 1)");
+  }
+}
+
 std::string write_stl(const PolygonMesh& mesh, const MeshWriteOptions& options) {
   // Polygons are split into a fan of triangles around their first corner.
   std::size_t triangles = 0;
@@ -210,9 +244,6 @@ std::string write_stl(const PolygonMesh& mesh, const MeshWriteOptions& options) 
     }
   };
   if (options.binary) {
-    if (triangles > 0xffffffffULL) {
-      throw InvalidInputError("", "too many triangles for binary STL");
-    }
     out.reserve(84 + 50 * triangles);
     std::string header = "binary STL written by libelastic";
     header.resize(80, ' ');

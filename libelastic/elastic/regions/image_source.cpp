@@ -1,16 +1,15 @@
 #include "elastic/regions/image_source.h"
 
-#include <stb_image.h>
-
 #include <cmath>
-#include <fstream>
 #include <numbers>
 
 #include "elastic/core/error.h"
+#include "elastic/image/image.h"
 
 namespace elastic {
 
-ImagePlane make_image_plane(const std::filesystem::path& image, const ImagePlaneOptions& options) {
+ImagePlane make_image_plane(const std::filesystem::path& image, const ImagePlaneOptions& options,
+                            const ImageReadOptions& read_options) {
   const std::string name = image.string();
   if (!(options.width > 0.0) || !std::isfinite(options.width)) {
     throw InvalidInputError(name, "image width must be finite and positive");
@@ -21,14 +20,11 @@ ImagePlane make_image_plane(const std::filesystem::path& image, const ImagePlane
   if (!(options.ellipse_margin >= 0.0 && options.ellipse_margin < 0.5)) {
     throw InvalidInputError(name, "ellipse margin must be in [0, 0.5)");
   }
-  if (!std::ifstream(image, std::ios::binary)) {
-    throw IoError(name, "cannot open the image");
-  }
-  int columns = 0, rows = 0, channels = 0;
-  if (!stbi_info(name.c_str(), &columns, &rows, &channels) || columns <= 0 || rows <= 0) {
-    throw InvalidInputError(name,
-                            std::string("not a readable image (") + stbi_failure_reason() + ")");
-  }
+  // Only the header is read: an image beyond read_options.max_pixels is refused here, before any
+  // work, rather than when its pixels are first needed.
+  const ImageInfo info = read_image_info(image, read_options);
+  const int columns = info.width;
+  const int rows = info.height;
 
   ImagePlane plane;
   plane.columns = columns;

@@ -16,6 +16,7 @@
 
 #include <filesystem>
 
+#include "elastic/image/image.h"
 #include "elastic/mesh/polygon_mesh.h"
 #include "elastic/regions/region_spec.h"
 
@@ -44,10 +45,13 @@ struct ImagePlane {
   double height = 0.0;
 };
 
-/// Reads the image's size and builds the plane carrying it.
+/// Reads the image's size (only its header, checked against `read_options`, before any work; pass
+/// the same read options to whatever later reads its pixels) and builds the plane carrying it.
 /// \throws IoError when the file cannot be read; InvalidInputError when it is not an image stb can
-///         decode (PNG, JPEG, BMP, TGA, ...) or the options are out of range.
+///         decode (PNG, JPEG, BMP, TGA, ...), has more pixels than `read_options.max_pixels`, or
+///         the options are out of range.
 ImagePlane make_image_plane(const std::filesystem::path& image,
-                            const ImagePlaneOptions& options = {});
+                            const ImagePlaneOptions& options = {},
+                            const ImageReadOptions& read_options = {});
 
 }  // namespace elastic

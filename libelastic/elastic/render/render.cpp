@@ -658,13 +658,14 @@ Eigen::Vector3d vector_area(const PolygonMesh& mesh) {
   return 0.5 * sum;
 }
 
-MaterialTextures load_material_textures(const PolygonMesh& mesh) {
+MaterialTextures load_material_textures(const PolygonMesh& mesh,
+                                        const ImageReadOptions& read_options) {
   MaterialTextures result;
   for (const Material& material : mesh.materials) {
     Image image;
     if (!material.diffuse_texture.empty()) {
       try {
-        image = read_image(material.diffuse_texture);
+        image = read_image(material.diffuse_texture, read_options);
       } catch (const Error& e) {
         result.warnings.push_back(e.what());
       }

@@ -126,13 +126,14 @@ struct RenderOptions {
 Image render(const Scene& scene, const Camera& camera, const RenderOptions& options = {});
 
 /// The textures of a mesh's materials, for ObjectLook::textures: one image per material (empty
-/// where the material has none or its file cannot be read; those files are listed in `warnings`,
-/// "<file>: <problem>").
+/// where the material has none or its file cannot be read or has more pixels than
+/// `read_options.max_pixels`; those files are listed in `warnings`, "<file>: <problem>").
 struct MaterialTextures {
   std::vector<Image> images;
   std::vector<std::string> warnings;
 };
-MaterialTextures load_material_textures(const PolygonMesh& mesh);
+MaterialTextures load_material_textures(const PolygonMesh& mesh,
+                                        const ImageReadOptions& read_options = {});
 
 /// The bounding box of a mesh's vertices (empty for a mesh without vertices).
 Eigen::AlignedBox3d bounding_box(const PolygonMesh& mesh);

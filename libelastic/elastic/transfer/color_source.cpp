@@ -86,7 +86,8 @@ Eigen::Vector2d ColorSource::texcoord(const SurfacePoint& p) const {
   return texture_coordinate(*surface_, p);
 }
 
-ColorSource ColorSource::texture(const LimitSurface& surface, const std::filesystem::path& image) {
+ColorSource ColorSource::texture(const LimitSurface& surface, const std::filesystem::path& image,
+                                 const ImageReadOptions& read_options) {
   if (!surface.control_mesh().has_texcoords()) {
     throw InvalidInputError(surface.name(),
                             "has no texture coordinates (needed for a texture colour source)");
@@ -104,7 +105,7 @@ ColorSource ColorSource::texture(const LimitSurface& surface, const std::filesys
                               "has no material with a diffuse texture (map_Kd); give an image");
     }
   }
-  return texture(surface, read_image(path), path);
+  return texture(surface, read_image(path, read_options), path);
 }
 
 ColorSource ColorSource::texture(const LimitSurface& surface, Image image,

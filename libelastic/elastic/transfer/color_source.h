@@ -65,8 +65,9 @@ class ColorSource {
   /// The control mesh's texture coordinates index `image` (or, when `image` is empty, the image of
   /// the control mesh's first material with a `map_Kd`, read with read_image).
   /// \throws InvalidInputError naming the surface when it has no texture coordinates or no
-  ///         material texture; IoError / InvalidInputError from read_image.
-  static ColorSource texture(const LimitSurface& surface, const std::filesystem::path& image = {});
+  ///         material texture; IoError / InvalidInputError from read_image (with `read_options`).
+  static ColorSource texture(const LimitSurface& surface, const std::filesystem::path& image = {},
+                             const ImageReadOptions& read_options = {});
   /// The same with an image already in memory (`path` only names it).
   static ColorSource texture(const LimitSurface& surface, Image image,
                              std::filesystem::path path = {});

@@ -157,9 +157,14 @@ inline void append_number(std::string& out, int value) {
 /// Lower-cased file extension with the dot (".obj").
 std::string lower_extension(const std::filesystem::path& path);
 
-/// Checks a mesh before writing: offsets, indices, attribute sizes, finite positions.
+/// Checks a mesh before writing: offsets, indices, attribute sizes, and that every number to be
+/// written (positions, texture coordinates, normals, colours, sharpness values) is finite.
 /// \throws InvalidInputError naming `path`.
 void check_writable(const PolygonMesh& mesh, const std::filesystem::path& path);
+
+/// Checks what only STL limits: every written vertex within float range (STL stores 32-bit
+/// floats), at most 2^32 - 1 triangles. \throws InvalidInputError naming `path`.
+void check_stl_writable(const PolygonMesh& mesh, const std::filesystem::path& path);
 
 /// A colour channel in [0,1] as an 8-bit value (rounded, clamped).
 inline int to_byte(float c) {
