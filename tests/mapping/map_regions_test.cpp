@@ -4,6 +4,8 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
 #include <random>
 
 #include "elastic/regions/region_spec.h"
@@ -71,6 +73,48 @@ TEST(MapRegions, PlaneOntoCapConvergesWithoutFolds) {
 // Forward then inverse returns near the start (both directions are the grid's affine map per
 // triangle; they differ only by the magnet's step off the particles' chord planes on the cylinder,
 // see mapping_test.cpp for the bound), and points outside the region answer "outside".
+// --boundary slide: the plane's square (four corners, where the fixed arc-length boundary forces
+// the most distortion) onto the cap's round boundary. Every boundary particle stays on the target
+// curve at its parameter (checked here against the disk map's curve point, not the solver's own
+// residual), the particles keep their order along the curve, some do slide, and the energy ends
+// below the fixed boundary's.
+TEST(MapRegions, SlidingBoundaryStaysOnTheCurveInOrder) {
+  const LimitSurface source_surface(make_plane({.resolution = 8}));
+  const LimitSurface target_surface(make_cap({.resolution = 16}));
+  const SurfaceProjector source(source_surface), target(target_surface);
+  const Region from = make_region(source, parse_region_spec("boundary"));
+  const Region to = make_region(target, parse_region_spec("boundary"));
+  MapOptions options;
+  options.sampling.layout.particles = 600;
+  const MapResult fixed = map_regions(source, from, target, to, options);
+  options.relaxation.boundary = BoundaryMode::Slide;
+  const MapResult slid = map_regions(source, from, target, to, options);
+  const RelaxationResult& r = slid.relaxation;
+  EXPECT_TRUE(r.converged) << to_string(r.reason);
+  EXPECT_EQ(r.folded_faces, 0);
+  EXPECT_EQ(r.boundary, BoundaryMode::Slide);
+  const std::vector<int>& loop = slid.sampling.grid.boundary_loop;
+  ASSERT_EQ(r.boundary_parameters.size(), loop.size());
+  double moved = 0.0;
+  for (std::size_t k = 0; k < loop.size(); ++k) {
+    const SurfacePoint at = slid.target_disk->boundary_point(r.boundary_parameters[k]);
+    EXPECT_LT((target_surface.position(at) - r.positions.col(loop[k])).norm(), 1e-9) << k;
+    // In order: the step to the next parameter (cyclically) is positive and short.
+    const double next = r.boundary_parameters[(k + 1) % loop.size()];
+    double gap = next - r.boundary_parameters[k];
+    gap -= std::floor(gap);
+    EXPECT_GT(gap, 0.0) << k;
+    EXPECT_LT(gap, 0.1) << k;
+    double shift = r.boundary_parameters[k] - slid.sampling.grid.boundary_parameter[k];
+    shift -= std::round(shift);
+    moved = std::max(moved, std::abs(shift));
+  }
+  EXPECT_GT(moved, 1e-3);
+  EXPECT_LT(r.length_energy + r.angular_energy + r.barrier_energy,
+            fixed.relaxation.length_energy + fixed.relaxation.angular_energy +
+                fixed.relaxation.barrier_energy);
+}
+
 TEST(MapRegions, MappingAnswersBothWays) {
   const LimitSurface source_surface(make_plane({.resolution = 8}));
   const LimitSurface target_surface(make_cylinder({.resolution = 24}));

@@ -79,6 +79,10 @@ void add_map_flags(CLI::App& sub, MapJob& a) {
   sub.add_option("--rest-scale", a.rest_scale,
                  "auto (default: the smaller of boundary and area) | boundary | area | none")
       ->check(CLI::IsMember({"auto", "boundary", "area", "none"}));
+  sub.add_option("--boundary", a.boundary,
+                 "fixed (the paper's arc-length boundary) or slide (boundary particles move "
+                 "along the target curve, in order, to lower the energy)")
+      ->check(CLI::IsMember({"fixed", "slide"}));
   sub.add_option("--boundary-offset", a.boundary_offset,
                  "auto (default: turn the correspondence to the least naive-map energy when no "
                  "anchor is given) or anchor (start at the regions' anchors)")
@@ -109,6 +113,7 @@ MapOptions make_map_options(const MapJob& job, const ProgressCallback& progress)
   options.relaxation.solver = job.solver == "explicit" ? SolverKind::Faithful : SolverKind::Fast;
   options.relaxation.energy = parse_energy_kind(job.energy, "--energy");
   options.choose_offset = job.boundary_offset == "auto";
+  options.relaxation.boundary = parse_boundary_mode(job.boundary, "--boundary");
   options.relaxation.lbfgs.preconditioner =
       parse_preconditioner(job.preconditioner, "--preconditioner");
   options.relaxation.threads = job.threads;
@@ -215,6 +220,7 @@ nlohmann::json map_report(const MapJob& job, const MapSession& session,
           {"initial_folds", x.initial_folded_faces},
           {"boundary_residual", x.boundary_residual},
           {"rest_scale", {{"mode", job.rest_scale}, {"factor", r.rest_scale}}},
+          {"boundary", {{"mode", std::string(to_string(x.boundary))}, {"slide", x.boundary_slide}}},
           {"boundary_offset",
            {{"chosen", r.offset_chosen},
             {"offset", r.boundary_offset},

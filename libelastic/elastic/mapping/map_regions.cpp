@@ -24,6 +24,10 @@ MapResult map_regions(const SurfaceProjector& source, const Region& source_regio
   if (options.subdivisions < 0) {
     throw InvalidInputError("subdivisions", "must be 0 or more");
   }
+  if (options.subdivisions > 0 && options.relaxation.boundary == BoundaryMode::Slide) {
+    // refine_map places new boundary particles at the source parameters' midpoints.
+    throw InvalidInputError("subdivisions", "cannot be combined with a sliding boundary yet");
+  }
   auto stage = [&](std::string_view name) {
     if (!report_progress(options.progress, {.stage = name})) {
       throw Error("map", "cancelled during " + std::string(name));
@@ -85,6 +89,8 @@ MapResult map_regions(const SurfaceProjector& source, const Region& source_regio
     problem.boundary_targets.col(static_cast<Eigen::Index>(k)) =
         result.naive.positions.col(grid.boundary_loop[k]);
   }
+  const RegionDiskMap* target_disk = result.target_disk.get();
+  problem.boundary_curve = [target_disk](double s) { return target_disk->boundary_point(s); };
   result.relaxation = relax(problem, options.relaxation);
   result.sampled_particles = grid.num_particles();
 

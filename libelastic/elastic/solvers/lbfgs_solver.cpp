@@ -82,26 +82,38 @@ struct InteriorLayout {
   const RelaxationSetup* setup;
   Eigen::Index n;
 
-  // q = tangential part of the gradient at the interior particles: g_i - n_i (n_i . g_i).
+  // The tangent space of free entry k: the surface's tangent plane (g - n (n . g)), or for a
+  // sliding boundary particle the curve's tangent line (t (t . g)); `tangents` holds the curve
+  // tangents of the state the normals belong to.
+  Eigen::Vector3d to_tangent(Eigen::Index k, const Eigen::Vector3d& g,
+                             const Eigen::Matrix3Xd& normals,
+                             const Eigen::Matrix3Xd& tangents) const {
+    const int p = setup->interior[static_cast<std::size_t>(k)];
+    if (setup->sliding[static_cast<std::size_t>(k)] >= 0) {
+      const Eigen::Vector3d t = tangents.col(p);
+      return t * t.dot(g);
+    }
+    const Eigen::Vector3d nrm = normals.col(p);
+    return g - nrm * nrm.dot(g);
+  }
+
+  // q = tangential part of the gradient at the free particles.
   void tangential(const Eigen::Matrix3Xd& gradient, const Eigen::Matrix3Xd& normals,
-                  Eigen::VectorXd& q) const {
+                  const Eigen::Matrix3Xd& tangents, Eigen::VectorXd& q) const {
     for_chunks(n, [&](Eigen::Index k) {
       const int p = setup->interior[static_cast<std::size_t>(k)];
-      const Eigen::Vector3d g = gradient.col(p);
-      const Eigen::Vector3d nrm = normals.col(p);
-      const Eigen::Vector3d t = g - nrm * nrm.dot(g);
+      const Eigen::Vector3d t = to_tangent(k, gradient.col(p), normals, tangents);
       for (int c = 0; c < 3; ++c) {
         q[c * n + k] = t[c];
       }
     });
   }
 
-  void project(Eigen::VectorXd& v, const Eigen::Matrix3Xd& normals) const {
+  void project(Eigen::VectorXd& v, const Eigen::Matrix3Xd& normals,
+               const Eigen::Matrix3Xd& tangents) const {
     for_chunks(n, [&](Eigen::Index k) {
-      const int p = setup->interior[static_cast<std::size_t>(k)];
-      const Eigen::Vector3d nrm = normals.col(p);
-      const Eigen::Vector3d t(v[k], v[n + k], v[2 * n + k]);
-      const Eigen::Vector3d u = t - nrm * nrm.dot(t);
+      const Eigen::Vector3d u =
+          to_tangent(k, Eigen::Vector3d(v[k], v[n + k], v[2 * n + k]), normals, tangents);
       for (int c = 0; c < 3; ++c) {
         v[c * n + k] = u[c];
       }
@@ -221,7 +233,7 @@ RelaxationResult relax_lbfgs(const RelaxationProblem& problem, const RelaxationO
   for (Eigen::VectorXd* v : {&q, &q_free, &direction, &trial_q}) {
     resize_huge(*v, m, 1);
   }
-  layout.tangential(gradient, setup.normals, q);
+  layout.tangential(gradient, setup.normals, setup.curve_tangent, q);
   double q_norm = std::sqrt(dot(q, q));
   // The relative stopping test is scaled by the springs' own initial gradient: near-collapsed
   // triangles of the start can make the barrier's share of the first gradient orders of magnitude
@@ -259,6 +271,9 @@ RelaxationResult relax_lbfgs(const RelaxationProblem& problem, const RelaxationO
   advise_huge_pages(trial_points.data(), setup.points.size() * sizeof(SurfacePoint));
   trial_points.assign(setup.points.begin(), setup.points.end());
   std::vector<char> trial_folded;
+  // Sliding boundary: trial curve parameters, tangents and speeds.
+  Eigen::Matrix3Xd trial_tangents = setup.curve_tangent;
+  std::vector<double> trial_s = setup.curve_s, trial_speed = setup.curve_speed;
 
   const auto emit_frame = [&](long iteration) {
     if (options.frame && iteration % options.frame_interval == 0) {
@@ -333,14 +348,14 @@ RelaxationResult relax_lbfgs(const RelaxationProblem& problem, const RelaxationO
       axpy(alphas[k] - beta, memory[k].s, direction);
     }
     direction = -direction;
-    layout.project(direction, setup.normals);
+    layout.project(direction, setup.normals, setup.curve_tangent);
     double slope = dot(q_free, direction);
     if (!(slope < 0.0)) {
       memory.clear();
       direction = q_free;
       apply_h0(direction);
       direction = -direction;
-      layout.project(direction, setup.normals);
+      layout.project(direction, setup.normals, setup.curve_tangent);
       slope = dot(q_free, direction);
       if (!(slope < 0.0)) {  // L is SPD, so only round-off gets here: fall back to steepest descent
         direction = -q_free;
@@ -364,6 +379,28 @@ RelaxationResult relax_lbfgs(const RelaxationProblem& problem, const RelaxationO
               trial_positions.col(col) = setup.positions.col(col);
               trial_normals.col(col) = setup.normals.col(col);
               frame = frames[kk];
+              if (setup.sliding[kk] >= 0) {
+                const auto b = static_cast<std::size_t>(setup.sliding[kk]);
+                trial_s[b] = setup.curve_s[b];
+                trial_speed[b] = setup.curve_speed[b];
+                trial_tangents.col(col) = setup.curve_tangent.col(col);
+              }
+              return;
+            }
+            const int on_curve = setup.sliding[kk];
+            if (on_curve >= 0) {  // along the curve: ds = (t . step) / |dc/ds|
+              const auto b = static_cast<std::size_t>(on_curve);
+              trial_s[b] = setup.curve_s[b] + setup.curve_tangent.col(col).dot(step) /
+                                                  std::max(setup.curve_speed[b], 1e-300);
+              Eigen::Vector3d position, tangent;
+              setup.curve_frame(trial_s[b], trial_points[p], position, tangent, trial_speed[b]);
+              trial_positions.col(col) = position;
+              trial_tangents.col(col) = tangent;
+              const SurfaceDerivatives d = setup.target.surface().derivatives(trial_points[p]);
+              const Eigen::Vector3d normal = d.du.cross(d.dv);
+              trial_normals.col(col) = normal.norm() > 1e-300
+                                           ? Eigen::Vector3d(normal.normalized())
+                                           : Eigen::Vector3d(setup.normals.col(col));
               return;
             }
             ClosestPoint out;
@@ -409,6 +446,12 @@ RelaxationResult relax_lbfgs(const RelaxationProblem& problem, const RelaxationO
       trial_q_ready = false;
       retract(alpha);
       setup.springs.folded_corners(trial_positions, trial_normals, trial_folded);
+      if (setup.slide && !solver_detail::RelaxationSetup::in_order(trial_s)) {
+        // A boundary particle would pass its neighbour on the curve: shorten the step.
+        alpha *= 0.5;
+        ++backtracks;
+        continue;
+      }
       // A first few folding trials only shorten the step; then the folding particles are blocked.
       // With the injectivity barrier (EnergyKind::Robust) a short enough step never folds (the
       // energy grows without bound first), so folding trials are only shortened, never blocked.
@@ -451,7 +494,7 @@ RelaxationResult relax_lbfgs(const RelaxationProblem& problem, const RelaxationO
           direction = q_free;
           apply_h0(direction);
           direction = -direction;
-          layout.project(direction, setup.normals);
+          layout.project(direction, setup.normals, setup.curve_tangent);
           slope = dot(q_free, direction);
         } else {
           alpha *= 0.5;
@@ -469,7 +512,7 @@ RelaxationResult relax_lbfgs(const RelaxationProblem& problem, const RelaxationO
           accepted = true;
         } else if (trial_energy <= energy + round_off(energy)) {
           // Within round-off of the current energy: accept on a smaller tangential gradient.
-          layout.tangential(trial_gradient, trial_normals, trial_q);
+          layout.tangential(trial_gradient, trial_normals, trial_tangents, trial_q);
           trial_q_ready = true;
           accepted = free_norm(trial_q) < std::sqrt(dot(q_free, q_free));
         }
@@ -490,7 +533,7 @@ RelaxationResult relax_lbfgs(const RelaxationProblem& problem, const RelaxationO
     }
 
     if (!trial_q_ready) {
-      layout.tangential(trial_gradient, trial_normals, trial_q);
+      layout.tangential(trial_gradient, trial_normals, trial_tangents, trial_q);
     }
     if (next.s.size() != m) {
       resize_huge(next.s, m, 1);
@@ -518,6 +561,15 @@ RelaxationResult relax_lbfgs(const RelaxationProblem& problem, const RelaxationO
 
     setup.positions.swap(trial_positions);
     setup.normals.swap(trial_normals);
+    if (setup.slide) {
+      setup.curve_s.swap(trial_s);
+      setup.curve_speed.swap(trial_speed);
+      setup.curve_tangent.swap(trial_tangents);
+      // Entries that did not move keep their values in both buffers (the retraction copies them).
+      trial_s = setup.curve_s;
+      trial_speed = setup.curve_speed;
+      trial_tangents = setup.curve_tangent;
+    }
     setup.points.swap(trial_points);
     frames.swap(trial_frames);
     folded.swap(trial_folded);

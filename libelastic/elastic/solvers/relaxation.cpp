@@ -70,6 +70,21 @@ std::string_view to_string(StopReason reason) {
   return "unknown";
 }
 
+std::string_view to_string(BoundaryMode mode) {
+  return mode == BoundaryMode::Fixed ? "fixed" : "slide";
+}
+
+BoundaryMode parse_boundary_mode(std::string_view text, std::string_view input) {
+  if (text == "fixed") {
+    return BoundaryMode::Fixed;
+  }
+  if (text == "slide") {
+    return BoundaryMode::Slide;
+  }
+  throw InvalidInputError(std::string(input), "unknown boundary mode '" + std::string(text) +
+                                                  "' (expected fixed or slide)");
+}
+
 std::string_view to_string(EnergyKind kind) {
   return kind == EnergyKind::Robust ? "robust" : "paper";
 }
@@ -98,6 +113,7 @@ RelaxationResult relax_fast_paper(const RelaxationProblem& problem,
   RelaxationProblem again = problem;
   again.initial_positions = fast.positions;
   again.initial_points = fast.points;
+  again.boundary_parameters = fast.boundary_parameters;
   RelaxationOptions dynamics = options;
   dynamics.solver = SolverKind::Faithful;
   dynamics.max_iterations = options.untangle_steps;
@@ -154,6 +170,7 @@ RelaxationResult relax_fast(const RelaxationProblem& problem, const RelaxationOp
   RelaxationProblem again = problem;
   again.initial_positions = paper.positions;
   again.initial_points = paper.points;
+  again.boundary_parameters = paper.boundary_parameters;
   RelaxationResult result = relax_lbfgs(again, options);
   result.initial_energy = robust.initial_energy;
   result.initial_folded_faces = robust.initial_folded_faces;

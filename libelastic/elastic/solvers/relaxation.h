@@ -116,6 +116,19 @@ struct LbfgsOptions {
   MultigridOptions multigrid;  ///< the V-cycle's parameters (Preconditioner::Multigrid)
 };
 
+/// What the boundary particles do during the relaxation.
+enum class BoundaryMode {
+  /// They stay where the boundary correspondence put them (the paper's arc-length boundary, §4.1).
+  Fixed,
+  /// They stay on the target curve, in order, and slide along it to lower the energy (fast solver;
+  /// needs RelaxationProblem::boundary_curve). The faithful solver keeps them fixed.
+  Slide
+};
+/// "fixed", "slide".
+std::string_view to_string(BoundaryMode mode);
+/// Parses "fixed" or "slide". \throws InvalidInputError naming `input` otherwise.
+BoundaryMode parse_boundary_mode(std::string_view text, std::string_view input = "boundary");
+
 /// Which energy the relaxation minimises.
 enum class EnergyKind {
   /// E_len + E_ang + the injectivity barrier E_bar (particles/spring_energy.h): the paper's
@@ -132,6 +145,8 @@ EnergyKind parse_energy_kind(std::string_view text, std::string_view input = "en
 
 struct RelaxationOptions {
   SolverKind solver = SolverKind::Fast;  ///< which solver
+  /// Fixed or sliding boundary particles (BoundaryMode).
+  BoundaryMode boundary = BoundaryMode::Fixed;
   /// The energy. The barrier of EnergyKind::Robust is used by the fast solver; the faithful
   /// solver (the paper's explicit integrator) always integrates the paper's forces.
   EnergyKind energy = EnergyKind::Robust;
@@ -176,6 +191,13 @@ struct RelaxationProblem {
   /// arc-length position). Optional: when empty, the boundary residual is measured against
   /// initial_positions.
   Eigen::Matrix3Xd boundary_targets;
+  /// The target boundary curve by correspondence parameter: boundary particle k of the grid sits
+  /// at boundary_curve(s_k), s periodic with period 1 (e.g. RegionDiskMap::boundary_point). Needed
+  /// by BoundaryMode::Slide.
+  std::function<SurfacePoint(double)> boundary_curve;
+  /// Start parameters s_k of the boundary particles (one per grid.boundary_loop entry) for
+  /// BoundaryMode::Slide; empty: the grid's boundary_parameter.
+  std::vector<double> boundary_parameters;
 };
 
 struct RelaxationResult {
@@ -214,8 +236,16 @@ struct RelaxationResult {
   /// (RelaxationOptions::untangle_steps), and whether their equilibrium was taken.
   long untangle_steps = 0;
   bool untangled = false;
-  double boundary_residual = 0.0;  ///< max distance of a boundary particle from its target position
-  double rest_scale = 1.0;         ///< sigma used
+  /// Max distance of a boundary particle from its target position (Fixed) or from the curve point
+  /// at its parameter (Slide).
+  double boundary_residual = 0.0;
+  BoundaryMode boundary = BoundaryMode::Fixed;  ///< the boundary mode used
+  /// Final correspondence parameter of each boundary particle (grid.boundary_loop order); with a
+  /// fixed boundary the start's.
+  std::vector<double> boundary_parameters;
+  /// Largest distance a boundary particle slid, as a fraction of the curve (0 when fixed).
+  double boundary_slide = 0.0;
+  double rest_scale = 1.0;                      ///< sigma used
   RestScale rest_scale_mode = RestScale::Auto;  ///< its mode, as given
   // Explicit integrator parameters actually used (0 for L-BFGS).
   double time_step = 0.0;         ///< dt

@@ -88,6 +88,28 @@ RelaxationSetup::RelaxationSetup(const RelaxationProblem& problem, const Relaxat
     is_free[p] = 1;
     interior.push_back(static_cast<int>(p));
   }
+  sliding.assign(interior.size(), -1);
+  slide = options.boundary == BoundaryMode::Slide && options.solver == SolverKind::Fast;
+  if (slide) {
+    if (!problem.boundary_curve) {
+      throw InvalidInputError(kName, "a sliding boundary needs the target boundary curve");
+    }
+    const std::vector<double>& start =
+        problem.boundary_parameters.empty() ? grid.boundary_parameter : problem.boundary_parameters;
+    if (start.size() != grid.boundary_loop.size()) {
+      throw InvalidInputError(kName, "boundary parameters do not match the boundary loop");
+    }
+    curve = &problem.boundary_curve;
+    curve_s = start;
+    curve_speed.assign(start.size(), 0.0);
+    for (std::size_t k = 0; k < grid.boundary_loop.size(); ++k) {
+      const auto p = static_cast<std::size_t>(grid.boundary_loop[k]);
+      interior_index[p] = static_cast<int>(interior.size());
+      is_free[p] = 1;
+      interior.push_back(static_cast<int>(p));
+      sliding.push_back(static_cast<int>(k));
+    }
+  }
 
   // Fresh buffers advised before they are written (core/huge_pages.h).
   resize_huge(positions, 3, num_particles);
@@ -115,6 +137,18 @@ RelaxationSetup::RelaxationSetup(const RelaxationProblem& problem, const Relaxat
                       }
                     });
 
+  if (slide) {
+    resize_huge(curve_tangent, 3, num_particles);
+    curve_tangent.setZero();
+    for (std::size_t k = 0; k < grid.boundary_loop.size(); ++k) {
+      const int p = grid.boundary_loop[k];
+      SurfacePoint point;
+      Eigen::Vector3d position, tangent;
+      curve_frame(curve_s[k], point, position, tangent, curve_speed[k]);
+      curve_tangent.col(p) = tangent;
+    }
+  }
+
   // Triangles folded at the start stay out of the barrier (it cannot be crossed: they could only
   // be held folded). The fold guard still keeps them from folding again once they unfold.
   springs.set_barrier_mask(positions, normals);
@@ -135,12 +169,44 @@ RelaxationSetup::RelaxationSetup(const RelaxationProblem& problem, const Relaxat
 double tangential_norm(const RelaxationSetup& setup, const Eigen::Matrix3Xd& gradient,
                        const Eigen::Matrix3Xd& normals) {
   double sum = 0.0;
-  for (const int p : setup.interior) {
+  for (std::size_t k = 0; k < setup.interior.size(); ++k) {
+    const int p = setup.interior[k];
     const Eigen::Vector3d g = gradient.col(p);
+    if (setup.sliding[k] >= 0) {  // along the curve only
+      const double along = setup.curve_tangent.col(p).dot(g);
+      sum += along * along;
+      continue;
+    }
     const Eigen::Vector3d n = normals.col(p);
     sum += (g - n * n.dot(g)).squaredNorm();
   }
   return std::sqrt(sum);
+}
+
+void RelaxationSetup::curve_frame(double s, SurfacePoint& point, Eigen::Vector3d& position,
+                                  Eigen::Vector3d& tangent, double& speed) const {
+  // c is piecewise smooth (linear in ptex parameters between the curve's vertices): a central
+  // difference over 1e-7 of the curve sees at most one kink, where it gives the mean direction.
+  constexpr double kDelta = 1e-7;
+  const LimitSurface& surface = target.surface();
+  const auto wrap = [](double t) { return t - std::floor(t); };
+  point = (*curve)(wrap(s));
+  position = surface.position(point);
+  const Eigen::Vector3d d =
+      surface.position((*curve)(wrap(s + kDelta))) - surface.position((*curve)(wrap(s - kDelta)));
+  speed = d.norm() / (2.0 * kDelta);
+  tangent = speed > 0.0 ? Eigen::Vector3d(d / d.norm()) : Eigen::Vector3d::Zero();
+}
+
+bool RelaxationSetup::in_order(const std::vector<double>& s) {
+  const std::size_t m = s.size();
+  for (std::size_t k = 0; k < m; ++k) {
+    const double gap = k + 1 < m ? s[k + 1] - s[k] : s[0] + 1.0 - s[k];
+    if (!(gap > 0.0 && gap < 1.0)) {
+      return false;
+    }
+  }
+  return true;
 }
 
 Eigen::SparseMatrix<double> interior_laplacian(const RelaxationSetup& setup,
@@ -180,7 +246,9 @@ Eigen::SparseMatrix<double> interior_laplacian(const RelaxationSetup& setup,
       return;
     }
     if (a == b) {
-      diagonal[a] += value;
+      // A sliding boundary row is weighted up by a tenth: with no particle held the spring
+      // Laplacian is singular (translations), and the preconditioner must stay definite.
+      diagonal[a] += setup.sliding[static_cast<std::size_t>(a)] >= 0 ? 1.1 * value : value;
     } else {
       ++start[static_cast<std::size_t>(std::min(a, b)) + 2];
     }
@@ -639,7 +707,30 @@ void finish_result(const RelaxationSetup& setup, const RelaxationProblem& proble
   result.relative_gradient =
       initial_gradient_norm > 0.0 ? result.gradient_norm / initial_gradient_norm : 0.0;
   result.folded_faces = setup.springs.folded_faces(setup.positions, setup.normals);
-  result.boundary_residual = boundary_residual(problem, setup.positions);
+  result.boundary = setup.slide ? BoundaryMode::Slide : BoundaryMode::Fixed;
+  if (setup.slide) {
+    // On the curve by construction: measured against the curve point at each final parameter.
+    const std::vector<double>& start = problem.boundary_parameters.empty()
+                                           ? setup.grid.boundary_parameter
+                                           : problem.boundary_parameters;
+    result.boundary_parameters = setup.curve_s;
+    result.boundary_residual = 0.0;
+    result.boundary_slide = 0.0;
+    for (std::size_t k = 0; k < setup.curve_s.size(); ++k) {
+      const double s = setup.curve_s[k] - std::floor(setup.curve_s[k]);
+      const Eigen::Vector3d on_curve = setup.target.surface().position((*setup.curve)(s));
+      const int p = setup.grid.boundary_loop[k];
+      result.boundary_residual =
+          std::max(result.boundary_residual, (setup.positions.col(p) - on_curve).norm());
+      result.boundary_slide =
+          std::max(result.boundary_slide, std::abs(setup.curve_s[k] - start[k]));
+      result.boundary_parameters[k] = s;
+    }
+  } else {
+    result.boundary_parameters = problem.boundary_parameters.empty() ? setup.grid.boundary_parameter
+                                                                     : problem.boundary_parameters;
+    result.boundary_residual = boundary_residual(problem, setup.positions);
+  }
   result.rest_scale = problem.rest_scale;
   result.rest_scale_mode = problem.rest_scale_mode;
   result.converged = is_converged(result.reason);

@@ -8,6 +8,7 @@
 #include <Eigen/Core>
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseCore>
+#include <functional>
 #include <memory>
 #include <vector>
 
@@ -32,7 +33,27 @@ struct RelaxationSetup {
   std::vector<SurfacePoint> points;  ///< #P current surface points
   Eigen::Matrix3Xd normals;          ///< 3 x #P unit surface normals at `points`
   double mean_rest = 0.0;            ///< mean normal-spring rest length, times sigma
-  double absolute_bound = 0.0;       ///< the absolute stopping bound on |P g|
+  // Sliding boundary (BoundaryMode::Slide, fast solver): the boundary particles are free entries
+  // too (at the end of `interior`), each moving along the curve only.
+  bool slide = false;
+  /// Per entry of `interior`: its index in grid.boundary_loop when it is a sliding boundary
+  /// particle, -1 for an interior particle.
+  std::vector<int> sliding;
+  /// Per grid.boundary_loop entry: the current curve parameter s (unwrapped: continuous in time).
+  std::vector<double> curve_s;
+  /// 3 x #P: unit tangent of the curve at each sliding boundary particle (zero elsewhere).
+  Eigen::Matrix3Xd curve_tangent;
+  /// Per grid.boundary_loop entry: |dc/ds|, the curve's length per unit of s.
+  std::vector<double> curve_speed;
+  /// The curve (problem.boundary_curve).
+  const std::function<SurfacePoint(double)>* curve = nullptr;
+  /// Position, unit tangent and speed of the curve at s (central differences of c).
+  void curve_frame(double s, SurfacePoint& point, Eigen::Vector3d& position,
+                   Eigen::Vector3d& tangent, double& speed) const;
+  /// True when the parameters `s` (grid.boundary_loop order, unwrapped) are still strictly in
+  /// order along the curve: every gap to the next one positive, and all within one turn.
+  static bool in_order(const std::vector<double>& s);
+  double absolute_bound = 0.0;  ///< the absolute stopping bound on |P g|
 
   int num_free() const { return static_cast<int>(interior.size()); }
 };
