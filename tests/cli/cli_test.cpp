@@ -188,6 +188,73 @@ TEST(Cli, PasteWritesEveryFileItListsAndRefusesColourlessSources) {
                65, "plane_quads.obj");
 }
 
+// The one verdict (docs/cli.md): a run that did not converge is a failure for map, compare and
+// paste alike: exit 70, exactly one stderr line naming what failed and what to try, the report
+// still written with the same verdict and the same fold count, and stdout's figures agreeing.
+TEST(Cli, ForcedFailureHasOneVerdictAcrossMapCompareAndPaste) {
+  const fs::path dir = test::scratch_dir("cli_verdict");
+  const std::string emblem = (dir / "emblem.png").string();
+  ASSERT_EQ(elastic("render --emblem " + emblem + " --size 64 --quiet", dir).code, 0);
+  // One L-BFGS iteration cannot reach the tolerance (this case needs about 17).
+  const std::string job = "--source-image " + emblem + " --target " + mesh("cap_quads.obj") +
+                          " --target-region disk:0,0,1,0.5 --particles 200 --max-iterations 1 ";
+  const auto one_line = [](const CliRun& run) {
+    EXPECT_EQ(run.code, 70) << run.err;
+    ASSERT_FALSE(run.err.empty());
+    EXPECT_EQ(run.err.find('\n'), run.err.size() - 1) << "more than one stderr line:\n" << run.err;
+    EXPECT_EQ(run.err.rfind("elastic: the map failed: not converged (iteration limit reached)", 0),
+              0u)
+        << run.err;
+    // What to try: a budget above the one given, the ellipse for a rectangle image, the area
+    // rest scale (the default is boundary), a sliding boundary.
+    for (const char* advice : {"--max-iterations above 1", "--source-region ellipse",
+                               "--rest-scale area", "--boundary slide"}) {
+      EXPECT_NE(run.err.find(advice), std::string::npos) << advice << " not in " << run.err;
+    }
+  };
+
+  const CliRun map = elastic("map " + job + "--report " + (dir / "map.json").string(), dir);
+  one_line(map);
+  EXPECT_NE(map.out.find("NOT converged"), std::string::npos) << map.out;
+  const nlohmann::json map_report = nlohmann::json::parse(std::ifstream(dir / "map.json"));
+  EXPECT_FALSE(map_report["converged"].get<bool>());
+  EXPECT_FALSE(map_report["verdict"]["ok"].get<bool>());
+  EXPECT_EQ(map_report["verdict"]["exit"], 70);
+  EXPECT_EQ(map_report["verdict"]["folds"], map_report["folds"]);
+  // stdout shows the report's one fold count.
+  EXPECT_NE(map.out.find("folds " + map_report["folds"].dump()), std::string::npos) << map.out;
+
+  const CliRun compare = elastic(
+      "compare -q " + job + "--baselines dcm --report " + (dir / "compare.json").string(), dir);
+  one_line(compare);
+  EXPECT_EQ(compare.err, map.err);  // the same verdict, word for word
+  const nlohmann::json compare_report = nlohmann::json::parse(std::ifstream(dir / "compare.json"));
+  EXPECT_EQ(compare_report["verdict"], map_report["verdict"]);
+  EXPECT_EQ(compare_report["methods"]["elastic"]["folds"], map_report["folds"]);
+  // The table is still printed, with ElasticPaint's failure marked.
+  EXPECT_NE(compare.out.find("| elastic | **not converged"), std::string::npos) << compare.out;
+  EXPECT_NE(compare.out.find("| dcm | "), std::string::npos) << compare.out;
+
+  const fs::path out = dir / "paste";
+  const CliRun paste = elastic("paste -q " + job + "--out " + out.string(), dir);
+  one_line(paste);
+  EXPECT_EQ(paste.err, map.err);
+  const nlohmann::json paste_report = nlohmann::json::parse(std::ifstream(out / "report.json"));
+  EXPECT_EQ(paste_report["verdict"], map_report["verdict"]);
+  EXPECT_EQ(paste_report["metrics"]["elastic"]["folds"], map_report["folds"]);
+
+  // The same job with the solver's budget converges fold-free: exit 0 and a silent stderr.
+  const std::string fine = "--source-image " + emblem + " --target " + mesh("cap_quads.obj") +
+                           " --target-region disk:0,0,1,0.5 --particles 200 --source-region "
+                           "ellipse ";
+  const CliRun ok = elastic("map " + fine + "--report " + (dir / "ok.json").string(), dir);
+  EXPECT_EQ(ok.code, 0) << ok.err;
+  EXPECT_TRUE(ok.err.empty()) << ok.err;
+  const nlohmann::json ok_report = nlohmann::json::parse(std::ifstream(dir / "ok.json"));
+  EXPECT_TRUE(ok_report["verdict"]["ok"].get<bool>());
+  EXPECT_EQ(ok_report["folds"], 0);
+}
+
 TEST(Cli, EverySubcommandHasHelpWithAnExample) {
   const fs::path dir = test::scratch_dir("cli_help");
   const CliRun top = elastic("--help", dir);

@@ -18,6 +18,7 @@
 
 #include "cli_common.h"
 #include "elastic/mapping/map_regions.h"
+#include "elastic/metrics/map_metrics.h"
 #include "elastic/regions/image_source.h"
 #include "elastic/regions/region.h"
 
@@ -57,6 +58,10 @@ struct MapSession {
   Region source_region;
   Region target_region;
   MapResult result;
+  /// The final map (result.relaxation) and the naive map measured on the grid by docs/metrics.md:
+  /// the one fold count (`folds`) every report and summary shows, and the verdict's.
+  MapMetrics metrics;
+  MapMetrics naive_metrics;
   double seconds_loading = 0.0;  ///< reading, repairing, limit surfaces, projectors, regions
   double seconds_total = 0.0;    ///< the whole run_map_job
   MapSession() = default;
@@ -85,11 +90,12 @@ void write_report(const std::string& path, const nlohmann::json& report);
 /// The two-line summary `elastic map` prints.
 void print_map_summary(const MapJob& job, const MapSession& session);
 
-/// The exit code of a map run: 0 when the solver converged, or when it stopped at the no-fold
-/// constraint (FoldConstrained) with zero folds (the map is usable: every particle but the held
-/// ones is at equilibrium; a note on stderr says so unless quiet); 70 (numerical failure)
-/// otherwise.
-int map_exit_code(const MapSession& session, bool quiet);
+/// Measures a placement of the session's particles on the target (docs/metrics.md) with the
+/// session's rest scale and the target's limit-surface normals; particles flagged in `outside` or
+/// without a valid surface point are left out.
+MapMetrics measure_placement(const MapSession& session, const Eigen::Matrix3Xd& positions,
+                             const std::vector<SurfacePoint>& points,
+                             std::vector<char> outside = {});
 
 /// Parses "X,Y,Z" (finite numbers). \throws InvalidInputError naming `flag`.
 Eigen::Vector3d parse_point(const std::string& text, const std::string& flag);
