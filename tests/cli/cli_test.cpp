@@ -4,7 +4,9 @@
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 
+#include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -253,6 +255,66 @@ TEST(Cli, ForcedFailureHasOneVerdictAcrossMapCompareAndPaste) {
   const nlohmann::json ok_report = nlohmann::json::parse(std::ifstream(dir / "ok.json"));
   EXPECT_TRUE(ok_report["verdict"]["ok"].get<bool>());
   EXPECT_EQ(ok_report["folds"], 0);
+}
+
+// `bench robustness` on two tiny cases (the command, not its figures): one that runs, one whose
+// region cannot be built. Every case carries a boolean `pass`; the running case's checks are
+// recomputed here from its reported figures by the documented criteria (docs/results.md).
+TEST(Cli, BenchRobustnessReportsEveryCaseWithItsVerdict) {
+  const fs::path dir = test::scratch_dir("cli_robustness");
+  const fs::path root = fs::path(ELASTIC_MESHES_DIR).parent_path();
+  std::ofstream(dir / "cases.json") << R"({"cases": [
+    {"name": "tiny plane → cap", "source": "meshes/plane_quads.obj",
+     "source_region": "disk:0,0,0,0.8", "target": "meshes/cap_quads.obj",
+     "target_region": "disk:0,0,1,0.5", "particles": 150, "reason": "a small case that runs"},
+    {"name": "off the surface", "source": "meshes/plane_quads.obj",
+     "source_region": "disk:0,0,50,0.5", "target": "meshes/cap_quads.obj", "particles": 150,
+     "reason": "a region that cannot be built"}]})";
+  const CliRun run = elastic(
+      "bench robustness -q --cases " + (dir / "cases.json").string() + " --root " + root.string() +
+          " --report " + (dir / "r.json").string() + " --markdown " + (dir / "r.md").string(),
+      dir);
+  ASSERT_EQ(run.code, 0) << run.err;
+  const nlohmann::json report = nlohmann::json::parse(std::ifstream(dir / "r.json"));
+  ASSERT_EQ(report["cases"].size(), 2u);
+  for (const auto& c : report["cases"]) EXPECT_TRUE(c["pass"].is_boolean()) << c.dump();
+
+  const nlohmann::json& ok = report["cases"][0];
+  ASSERT_FALSE(ok.contains("error")) << ok.dump();
+  // The best baseline by hand: the smallest figure among LSCM, ARAP, DCM with a valid map.
+  double best_sd = INFINITY, best_len = INFINITY;
+  for (const char* name : {"lscm", "arap", "dcm"}) {
+    const nlohmann::json& m = ok["methods"][name];
+    if (m.contains("error") || m["folds"] != 0 || m["outside"] != 0) continue;
+    best_sd = std::min(best_sd, m["symmetric_dirichlet"].get<double>());
+    best_len = std::min(best_len, m["length_energy"].get<double>());
+  }
+  ASSERT_TRUE(std::isfinite(best_sd));
+  EXPECT_EQ(ok["best"]["symmetric_dirichlet"].get<double>(), best_sd);
+  EXPECT_EQ(ok["best"]["length_energy"].get<double>(), best_len);
+  const nlohmann::json& e = ok["methods"]["elastic"];
+  const double sd = e["symmetric_dirichlet"].get<double>(), len = e["length_energy"].get<double>();
+  const bool expected = ok["verdict"]["exit"] == 0 && e["converged"].get<bool>() &&
+                        e["folds"] == 0 && e["sigma_min"].get<double>() >= 0.2 &&
+                        sd <= 1.02 * best_sd &&
+                        (len <= 0.9 * best_len || (best_len < 1e-4 && len <= best_len + 1e-5));
+  EXPECT_EQ(ok["pass"].get<bool>(), expected) << ok["checks"].dump();
+  // The verdict is map's: this small case converges fold-free.
+  EXPECT_EQ(ok["verdict"]["exit"], 0) << ok["verdict"].dump();
+
+  const nlohmann::json& bad = report["cases"][1];
+  EXPECT_FALSE(bad["pass"].get<bool>());
+  EXPECT_NE(bad["error"].get<std::string>().find("--source-region"), std::string::npos);
+
+  // The Markdown table: on stdout and in the file, one row per case and the summary.
+  std::ifstream md(dir / "r.md");
+  std::stringstream text;
+  text << md.rdbuf();
+  const std::string page = text.str();
+  EXPECT_EQ(page, run.out);
+  EXPECT_NE(page.find("| tiny plane → cap |"), std::string::npos) << page;
+  EXPECT_NE(page.find("| off the surface | error: "), std::string::npos) << page;
+  EXPECT_NE(page.find("of 2 cases pass"), std::string::npos) << page;
 }
 
 TEST(Cli, EverySubcommandHasHelpWithAnExample) {

@@ -109,7 +109,8 @@ MapOptions make_map_options(const MapJob& job, const ProgressCallback& progress)
 }
 
 std::unique_ptr<MapSession> run_map_job(const MapJob& job, const ProgressCallback& progress,
-                                        const FrameCallback& frame, long frame_interval) {
+                                        const FrameCallback& frame, long frame_interval,
+                                        SurfaceCache* cache) {
   const auto start = std::chrono::steady_clock::now();
   require_flag(job.target, "--target");
   if (job.particles < 16 || job.particles > 5'000'000) {
@@ -136,10 +137,23 @@ std::unique_ptr<MapSession> run_map_job(const MapJob& job, const ProgressCallbac
                                                                    : ImageRegionShape::Rectangle});
   }
   if (progress) progress({.stage = "load"});
-  s.source = s.image ? surface_from_mesh(s.image->mesh, job.source_image, job.scheme)
-                     : load_surface(job.source, job.scheme);
+  // A surface from the cache, or loaded (and then cached).
+  const auto surface = [&](const std::string& key, const auto& load) {
+    if (cache == nullptr) return load();
+    const auto found = cache->find(key);
+    if (found != cache->end()) return found->second;
+    return cache->emplace(key, load()).first->second;
+  };
+  s.source =
+      s.image
+          ? surface("image|" + job.source_image + "|" + std::to_string(job.image_width) + "|" +
+                        job.source_region + "|" + job.scheme,
+                    [&] { return surface_from_mesh(s.image->mesh, job.source_image, job.scheme); })
+          : surface("mesh|" + job.source + "|" + job.scheme,
+                    [&] { return load_surface(job.source, job.scheme); });
   print_warnings(s.source.warnings, job.quiet);
-  s.target = load_surface(job.target, job.scheme);
+  s.target = surface("mesh|" + job.target + "|" + job.scheme,
+                     [&] { return load_surface(job.target, job.scheme); });
   print_warnings(s.target.warnings, job.quiet);
 
   RegionSpec source_spec =

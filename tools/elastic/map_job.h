@@ -11,6 +11,7 @@
 
 #include <CLI/CLI.hpp>
 #include <Eigen/Core>
+#include <map>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <optional>
@@ -73,12 +74,18 @@ struct MapSession {
 /// repeat the map (e.g. `bench` timing several runs).
 MapOptions make_map_options(const MapJob& job, const ProgressCallback& progress = {});
 
+/// Loaded surfaces by file (or image) and scheme, for commands that map many jobs on the same
+/// meshes (`bench robustness`): each is read, repaired and prepared once.
+using SurfaceCache = std::map<std::string, LoadedSurface>;
+
 /// Validates the job, loads the surfaces and regions, and maps. Progress goes to `progress`
 /// (stage and solver iterations). \throws UsageError / InvalidInputError / IoError naming the flag
 /// or file; NumericalError when a stage fails.
-/// `frame` (optional) receives every `frame_interval`-th configuration of the relaxation.
+/// `frame` (optional) receives every `frame_interval`-th configuration of the relaxation. With a
+/// `cache`, surfaces already in it are reused and new ones are added.
 std::unique_ptr<MapSession> run_map_job(const MapJob& job, const ProgressCallback& progress = {},
-                                        const FrameCallback& frame = {}, long frame_interval = 1);
+                                        const FrameCallback& frame = {}, long frame_interval = 1,
+                                        SurfaceCache* cache = nullptr);
 
 /// The report of `elastic map` (keys in docs/getting-started.md) with `job` recorded under "job".
 nlohmann::json map_report(const MapJob& job, const MapSession& session,
