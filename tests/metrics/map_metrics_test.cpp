@@ -7,8 +7,10 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <array>
 #include <cmath>
 #include <numbers>
+#include <utility>
 
 #include "elastic/core/error.h"
 
@@ -76,6 +78,8 @@ void expect_perfect(const MapMetrics& m) {
   EXPECT_EQ(m.folds, 0);
   EXPECT_EQ(m.degenerate, 0);
   EXPECT_EQ(m.outside, 0);
+  // Same double-root amplification as stretch_linf: s2 = prod / s1.
+  EXPECT_NEAR(m.sigma_min, 1.0, 1e-7);
 }
 
 TEST(MapMetrics, IdentityIsPerfect) {
@@ -191,10 +195,37 @@ TEST(MapMetrics, RestScaleDividesOutAUniformScale) {
   EXPECT_NEAR(m.angle_error_max_deg, 0.0, 1e-9);
 }
 
+// Brute force of the fold definition in the plane z = 0 seen along `up` (+1 or -1): a face is
+// folded when a triangle of any of its triangulations has a non-positive signed area along `up`.
+// For a triangle that is itself; for a quad the triangles omitting one corner each.
+int brute_force_folds(const ParticleGrid& grid, const Eigen::Matrix3Xd& y, double up,
+                      std::vector<char>* per_face = nullptr) {
+  int count = 0;
+  for (const auto fh : grid.mesh.faces()) {
+    std::vector<int> c;
+    for (const auto vh : grid.mesh.fv_range(fh)) c.push_back(vh.idx());
+    const int n = static_cast<int>(c.size());
+    bool folded = false;
+    for (int omit = 0; omit < (n == 3 ? 1 : n); ++omit) {
+      std::array<int, 3> t{};
+      int m = 0;
+      for (int k = 0; k < n && m < 3; ++k) {
+        if (n == 3 || k != omit) t[m++] = c[k];
+      }
+      const Eigen::Vector3d a = y.col(t[0]), b = y.col(t[1]), d = y.col(t[2]);
+      const double z = (b.x() - a.x()) * (d.y() - a.y()) - (b.y() - a.y()) * (d.x() - a.x());
+      folded = folded || up * z <= 0.0;
+    }
+    count += folded ? 1 : 0;
+    if (per_face != nullptr) per_face->push_back(folded ? 1 : 0);
+  }
+  return count;
+}
+
 TEST(MapMetrics, FoldIsDetectedAgainstTheSurfaceNormal) {
   const ParticleGrid grid = make_grid(4, 4);
   Eigen::Matrix3Xd y = grid.source_positions();
-  // Push the interior particle (2, 2) (index 2 * 5 + 2) past its neighbour (3, 2): the triangles
+  // Push the interior particle (2, 2) (index 2 * 5 + 2) past its neighbour (3, 2): the faces
   // around it whose orientation changes are inverted in the plane.
   const int moved = 12;
   y.col(moved) = Eigen::Vector3d(3.6, 2.2, 0.0);
@@ -202,36 +233,121 @@ TEST(MapMetrics, FoldIsDetectedAgainstTheSurfaceNormal) {
   options.target_normals = constant_normals(grid.num_particles(), Eigen::Vector3d::UnitZ());
   const MapMetrics m = measure_map(grid, y, options);
 
-  // Brute force: the sign of the z component of each target triangle's normal.
-  int expected = 0;
-  for (size_t t = 0; t < m.triangles.size(); ++t) {
-    const Eigen::Vector3i& tri = m.triangles[t];
-    const double z = (y.col(tri[1]) - y.col(tri[0])).cross(y.col(tri[2]) - y.col(tri[0])).z();
-    const bool folded = z <= 0.0;
-    expected += folded ? 1 : 0;
-    EXPECT_EQ(m.per_triangle.folded[t] != 0, folded) << "triangle " << t;
-  }
+  std::vector<char> expected_faces;
+  const int expected = brute_force_folds(grid, y, 1.0, &expected_faces);
   EXPECT_GT(expected, 0);
   EXPECT_EQ(m.folds, expected);
+  ASSERT_EQ(m.per_face.folded.size(), expected_faces.size());
+  for (size_t f = 0; f < expected_faces.size(); ++f) {
+    EXPECT_EQ(m.per_face.folded[f], expected_faces[f]) << "face " << f;
+  }
+  // Triangles show their face's fold; an inverted triangle has a negative sigma_min.
+  for (size_t t = 0; t < m.triangles.size(); ++t) {
+    EXPECT_EQ(m.per_triangle.folded[t], expected_faces[m.triangle_face[t]]) << "triangle " << t;
+  }
+  EXPECT_LT(m.sigma_min, 0.0);
 
-  // Seen from below (normals -z) every other triangle is the folded one.
+  // Seen from below (normals -z) every face has an inverted triangle except those whose every
+  // triangle is inverted from above.
   options.target_normals = constant_normals(grid.num_particles(), -Eigen::Vector3d::UnitZ());
-  EXPECT_EQ(measure_map(grid, y, options).folds, static_cast<int>(m.triangles.size()) - expected);
+  EXPECT_EQ(measure_map(grid, y, options).folds, brute_force_folds(grid, y, -1.0));
 
   // Without normals the fold test is not made.
   EXPECT_EQ(measure_map(grid, y).folds, -1);
 }
 
+// One unit-square quad, corners (0,0), (1,0), (1,1), (0,1) counter-clockwise, so its first-corner
+// fan is split along the diagonal 0-2.
+ParticleGrid single_quad_grid() {
+  ParticleGrid grid;
+  std::vector<GridMesh::VertexHandle> v;
+  for (const auto& [x, y] : {std::pair{0.0, 0.0}, {1.0, 0.0}, {1.0, 1.0}, {0.0, 1.0}}) {
+    v.push_back(grid.mesh.add_vertex(GridMesh::Point(x, y, 0.0)));
+  }
+  grid.mesh.add_face(v[0], v[1], v[2], v[3]);
+  grid.source_points.assign(4, SurfacePoint{});
+  grid.is_boundary.assign(4, 0);
+  grid.build_springs();
+  return grid;
+}
+
+TEST(MapMetrics, QuadFoldedOnlyAlongItsOtherDiagonalIsFolded) {
+  // Corner 0 moved to (0.7, 0.7), inside the triangle (1, 2, 3): the quad is not convex (reflex at
+  // corner 0). The split along 0-2 (the fan the heatmap shows) has two positive triangles, the
+  // split along 1-3 has the inverted triangle (1, 3, 0). By hand, from corner 1: source edges
+  // (-1, 1), (-1, 0), target edges (-1, 1), (-0.3, 0.7), so J = T S^-1 = [[0.3, -0.7], [-0.7,
+  // 0.3]], symmetric with eigenvalues 1 and -0.4: singular values 1 and 0.4, det -0.4 (inverted),
+  // so the signed sigma_min of that triangle is -0.4. The fan's triangles: (0, 1, 2) has J = [[0.3,
+  // 0], [-0.7, 1]] (det 0.3), (0, 2, 3) the mirror image; (1, 2, 3) is untouched (1, 1).
+  const ParticleGrid grid = single_quad_grid();
+  Eigen::Matrix3Xd y = grid.source_positions();
+  y.col(0) = Eigen::Vector3d(0.7, 0.7, 0.0);
+  MapMetricsOptions options;
+  options.target_normals = constant_normals(4, Eigen::Vector3d::UnitZ());
+  const MapMetrics m = measure_map(grid, y, options);
+  ASSERT_EQ(m.triangles.size(), 2u);
+  EXPECT_EQ(m.folds, 1);
+  EXPECT_EQ(m.per_face.folded[0], 1);
+  EXPECT_EQ(m.degenerate, 0);
+  EXPECT_NEAR(m.sigma_min, -0.4, kTight);
+  EXPECT_NEAR(m.per_face.sigma_min[0], -0.4, kTight);
+  // Both fan triangles are positive: s1 s2 = det = 0.3, s1^2 + s2^2 = |J|_F^2 = 1.58.
+  const double s2 = 0.5 * (std::sqrt(1.58 + 0.6) - std::sqrt(1.58 - 0.6));
+  for (int t = 0; t < 2; ++t) {
+    EXPECT_NEAR(m.per_triangle.s2[t], s2, kTight);
+    EXPECT_NEAR(m.per_triangle.s1[t] * m.per_triangle.s2[t], 0.3, kTight);
+    EXPECT_EQ(m.per_triangle.folded[t], 1);  // shown as its face
+  }
+
+  // The mirror case, corner 1 moved inside (0, 2, 3) to (0.3, 0.7): the fan's triangle (0, 1, 2)
+  // is the inverted one; the face is folded either way.
+  y = grid.source_positions();
+  y.col(1) = Eigen::Vector3d(0.3, 0.7, 0.0);
+  EXPECT_EQ(measure_map(grid, y, options).folds, 1);
+  // A convex quad (a parallelogram) is not folded.
+  y = grid.source_positions();
+  y.col(2) = Eigen::Vector3d(1.5, 1.0, 0.0);
+  y.col(3) = Eigen::Vector3d(0.5, 1.0, 0.0);
+  EXPECT_EQ(measure_map(grid, y, options).folds, 0);
+}
+
+TEST(MapMetrics, SigmaMinOfAnAffineMapIsItsSmallerSingularValueOverSigma) {
+  // x -> R diag(a, b) x with a = 2, b = 0.75 on a grid of quads and triangles: every triangle of
+  // every triangulation has singular values a and b; divided by sigma = 0.5 the worst is b / sigma.
+  const double a = 2.0, b = 0.75, sigma = 0.5;
+  const ParticleGrid grid = make_grid(4, 3);
+  const Eigen::Matrix3d r =
+      Eigen::AngleAxisd(-1.1, Eigen::Vector3d(0.4, -0.1, 1.0).normalized()).toRotationMatrix();
+  const Eigen::Matrix3Xd y =
+      transformed(grid.source_positions(), r * Eigen::Vector3d(a, b, 1.0).asDiagonal(),
+                  Eigen::Vector3d(-2.0, 0.5, 4.0));
+  MapMetricsOptions options;
+  options.rest_scale = sigma;
+  options.target_normals = constant_normals(grid.num_particles(), r * Eigen::Vector3d::UnitZ());
+  const MapMetrics m = measure_map(grid, y, options);
+  EXPECT_EQ(m.folds, 0);
+  EXPECT_NEAR(m.sigma_min, b / sigma, kTight);
+  for (const double v : m.per_face.sigma_min) EXPECT_NEAR(v, b / sigma, kTight);
+  // A mirror image (diag(a, -b)) inverts every triangle: sigma_min = -b / sigma, every face folded.
+  const Eigen::Matrix3Xd mirrored =
+      transformed(grid.source_positions(), r * Eigen::Vector3d(a, -b, 1.0).asDiagonal(),
+                  Eigen::Vector3d::Zero());
+  const MapMetrics w = measure_map(grid, mirrored, options);
+  EXPECT_EQ(w.folds, static_cast<int>(grid.mesh.n_faces()));
+  EXPECT_NEAR(w.sigma_min, -b / sigma, kTight);
+}
+
 TEST(MapMetrics, DegenerateTargetIsAFoldAndLeftOutOfTheMeans) {
   const ParticleGrid grid = make_grid(3, 3);
   Eigen::Matrix3Xd y = grid.source_positions();
-  // Collapse the whole map onto the x axis: every triangle degenerates.
+  // Collapse the whole map onto the x axis: every triangle degenerates, so every face folds.
   y.row(1).setZero();
   MapMetricsOptions options;
   options.target_normals = constant_normals(grid.num_particles(), Eigen::Vector3d::UnitZ());
   const MapMetrics m = measure_map(grid, y, options);
-  EXPECT_EQ(m.degenerate, static_cast<int>(m.triangles.size()));
+  EXPECT_EQ(m.degenerate, static_cast<int>(grid.mesh.n_faces()));
   EXPECT_EQ(m.folds, m.degenerate);
+  EXPECT_NEAR(m.sigma_min, 0.0, kTight);
   for (size_t t = 0; t < m.triangles.size(); ++t) {
     EXPECT_TRUE(std::isinf(m.per_triangle.symmetric_dirichlet[t]));
     EXPECT_NEAR(m.per_triangle.s2[t], 0.0, kTight);

@@ -30,7 +30,7 @@ LoadedSurface surface_from_mesh(PolygonMesh mesh, const std::string& path,
                                 const std::string& scheme) {
   LoadedSurface loaded;
   loaded.path = path;
-  loaded.mesh = std::make_unique<PolygonMesh>(std::move(mesh));
+  loaded.mesh = std::make_shared<PolygonMesh>(std::move(mesh));
   SanitizeResult sanitized = sanitize_mesh(*loaded.mesh, path);
   loaded.warnings.insert(loaded.warnings.end(), sanitized.warnings.begin(),
                          sanitized.warnings.end());
@@ -38,8 +38,8 @@ LoadedSurface surface_from_mesh(PolygonMesh mesh, const std::string& path,
   options.name = path;
   if (scheme == "loop") options.scheme = SubdivisionScheme::Loop;
   if (scheme == "catmull-clark") options.scheme = SubdivisionScheme::CatmullClark;
-  loaded.surface = std::make_unique<LimitSurface>(*loaded.mesh, options);
-  loaded.projector = std::make_unique<SurfaceProjector>(*loaded.surface);
+  loaded.surface = std::make_shared<LimitSurface>(*loaded.mesh, options);
+  loaded.projector = std::make_shared<SurfaceProjector>(*loaded.surface);
   return loaded;
 }
 

@@ -14,12 +14,13 @@
 namespace elastic::cli {
 
 /// A mesh file turned into a limit surface and its magnet. Heap-held so the references between them
-/// stay valid when the struct moves.
+/// stay valid when the struct moves; shared, so that copies (a cache of loaded surfaces, e.g. in
+/// `bench robustness`) share one surface and projector, which are read-only once built.
 struct LoadedSurface {
   std::string path;
-  std::unique_ptr<PolygonMesh> mesh;
-  std::unique_ptr<LimitSurface> surface;
-  std::unique_ptr<SurfaceProjector> projector;
+  std::shared_ptr<PolygonMesh> mesh;
+  std::shared_ptr<LimitSurface> surface;
+  std::shared_ptr<SurfaceProjector> projector;
   std::vector<std::string> warnings;  ///< reader and repair warnings, for the user
 };
 

@@ -5,7 +5,6 @@
 // report and a Markdown results page.
 #include <algorithm>
 #include <chrono>
-#include <ctime>
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
@@ -13,8 +12,9 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <sstream>
-#include <thread>
 
+#include "bench_common.h"
+#include "bench_robustness.h"
 #include "cli_common.h"
 #include "command.h"
 #include "compare_methods.h"
@@ -44,27 +44,6 @@ double median(std::vector<double> v) {
   std::sort(v.begin(), v.end());
   const size_t n = v.size();
   return n % 2 == 1 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
-
-std::string cpu_model() {
-  std::ifstream in("/proc/cpuinfo");
-  std::string line;
-  while (std::getline(in, line)) {
-    if (line.rfind("model name", 0) == 0) {
-      const auto colon = line.find(':');
-      if (colon != std::string::npos) return line.substr(colon + 2);
-    }
-  }
-  return "unknown";
-}
-
-std::string utc_now() {
-  const std::time_t t = std::time(nullptr);
-  std::tm tm{};
-  gmtime_r(&t, &tm);
-  std::ostringstream s;
-  s << std::put_time(&tm, "%Y-%m-%d %H:%M UTC");
-  return s.str();
 }
 
 std::string fmt(double v, int digits = 4) {
@@ -315,26 +294,11 @@ std::string results_markdown(const nlohmann::json& report) {
 
 int run_bench(const BenchArgs& args, const CLI::App& sub) {
   if (args.runs < 1) throw InvalidInputError("--runs", "must be at least 1");
-  nlohmann::json cases_file;
-  {
-    std::ifstream in(args.cases);
-    if (!in) throw IoError(args.cases, "cannot open the cases file");
-    try {
-      in >> cases_file;
-    } catch (const nlohmann::json::exception& e) {
-      throw InvalidInputError(args.cases, std::string("not valid JSON: ") + e.what());
-    }
-  }
-  if (!cases_file.contains("cases") || !cases_file["cases"].is_array()) {
-    throw InvalidInputError(args.cases, "expected an object with a \"cases\" array");
-  }
+  const nlohmann::json cases_file = read_cases_file(args.cases);
   nlohmann::json report;
   report["job"] = job_of(sub);
   report["runs"] = args.runs;
-  report["machine"] = {{"cpu", cpu_model()},
-                       {"threads", std::thread::hardware_concurrency()},
-                       {"solver_threads", args.threads},
-                       {"date", utc_now()}};
+  report["machine"] = machine_json(args.threads);
   report["cases"] = nlohmann::json::array();
   for (const auto& c : cases_file["cases"]) {
     if (c.value("extra", false) && !args.extra) continue;
@@ -372,25 +336,29 @@ int run_bench(const BenchArgs& args, const CLI::App& sub) {
 }  // namespace
 }  // namespace elastic::cli
 
-ELASTIC_COMMAND("bench", "Benchmarks: `bench table1` reproduces the paper's Table 1",
-                [](CLI::App& sub) {
-                  auto a = std::make_shared<elastic::cli::BenchArgs>();
-                  sub.require_subcommand(1);
-                  CLI::App* table1 = sub.add_subcommand(
-                      "table1", "The paper's nine cases: ElasticPaint and the baselines");
-                  table1->add_option("--cases", a->cases, "Cases file (JSON)");
-                  table1->add_option("--root", a->root,
-                                     "Folder the cases' mesh paths are relative to");
-                  table1->add_option("--report", a->report, "Write the JSON report here");
-                  table1->add_option("--markdown", a->markdown,
-                                     "Write the Markdown results page here (default: stdout)");
-                  table1->add_option("--runs", a->runs, "Runs per case (median seconds)")
-                      ->check(CLI::Range(1, 100));
-                  table1->add_option("--threads", a->threads, "Solver threads (0: all)")
-                      ->check(CLI::Range(0, 1024));
-                  table1->add_option("--only", a->only, "Run only the case with this name");
-                  table1->add_flag("--extra", a->extra,
-                                   "Also run the extra cases (real meshes of ../shared/meshes)");
-                  table1->add_flag("--quiet,-q", a->quiet, "No progress lines on stderr");
-                  return [a, table1] { return elastic::cli::run_bench(*a, *table1); };
-                });
+ELASTIC_COMMAND(
+    "bench", "Benchmarks: `bench table1` (the paper's Table 1), `bench robustness` (real inputs)",
+    [](CLI::App& sub) {
+      auto a = std::make_shared<elastic::cli::BenchArgs>();
+      sub.require_subcommand(1);
+      CLI::App* table1 =
+          sub.add_subcommand("table1", "The paper's nine cases: ElasticPaint and the baselines");
+      table1->add_option("--cases", a->cases, "Cases file (JSON)");
+      table1->add_option("--root", a->root, "Folder the cases' mesh paths are relative to");
+      table1->add_option("--report", a->report, "Write the JSON report here");
+      table1->add_option("--markdown", a->markdown,
+                         "Write the Markdown results page here (default: stdout)");
+      table1->add_option("--runs", a->runs, "Runs per case (median seconds)")
+          ->check(CLI::Range(1, 100));
+      table1->add_option("--threads", a->threads, "Solver threads (0: all)")
+          ->check(CLI::Range(0, 1024));
+      table1->add_option("--only", a->only, "Run only the case with this name");
+      table1->add_flag("--extra", a->extra,
+                       "Also run the extra cases (real meshes of ../shared/meshes)");
+      table1->add_flag("--quiet,-q", a->quiet, "No progress lines on stderr");
+      const std::function<int()> robustness = elastic::cli::add_robustness_subcommand(sub);
+      return [a, table1, robustness] {
+        if (table1->parsed()) return elastic::cli::run_bench(*a, *table1);
+        return robustness();
+      };
+    });

@@ -12,6 +12,7 @@
 #include "elastic/core/error.h"
 #include "job_file.h"
 #include "map_job.h"
+#include "verdict.h"
 
 namespace elastic::cli {
 namespace {
@@ -47,15 +48,18 @@ int run_compare(const CompareArgs& args, const CLI::App& sub) {
   const std::vector<MethodMeasurement> methods = compare_methods(*session, options);
 
   const nlohmann::json job = job_of(sub);
+  const MapVerdict verdict = judge_map(args.job, *session);
   nlohmann::json report = {{"job", job},
                            {"map", map_report(args.job, *session, job)},
-                           {"rest_scale", session->result.rest_scale}};
+                           {"rest_scale", session->result.rest_scale},
+                           {"verdict", verdict.to_json()}};
   nlohmann::json& out = report["methods"];
   out = nlohmann::json::object();
   for (const MethodMeasurement& m : methods) out[m.name] = measurement_json(m);
+  // The report and the table are written whatever the verdict: they are the diagnosis.
   write_report(args.job.report, report);
   std::cout << markdown_table(methods);
-  return kOk;
+  return finish(verdict);
 }
 
 }  // namespace
@@ -81,6 +85,8 @@ ELASTIC_COMMAND(
           "\\\n      --report compare.json --heatmap heatmaps/\n"
           "Every method is measured on the same particle grid with the same boundary "
           "correspondence;\nthe report has every metric of docs/metrics.md and the seconds of each "
-          "method.");
+          "method.\nExit 0 when ElasticPaint converged with no folds, 70 otherwise (one line on "
+          "stderr); the "
+          "report\nand the table are written either way.");
       return [a, &sub] { return elastic::cli::run_compare(*a, sub); };
     });

@@ -14,6 +14,7 @@
 #include "elastic/mesh/mesh_io.h"
 #include "job_file.h"
 #include "map_job.h"
+#include "verdict.h"
 
 namespace elastic::cli {
 namespace {
@@ -39,7 +40,7 @@ int run_map(const MapArgs& args, const CLI::App& sub) {
   }
   write_report(args.job.report, report);
   print_map_summary(args.job, *session);
-  return map_exit_code(*session, args.job.quiet);
+  return finish(judge_map(args.job, *session));
 }
 
 }  // namespace

@@ -26,6 +26,7 @@
 #include "job_file.h"
 #include "map_job.h"
 #include "paste_preview.h"
+#include "verdict.h"
 
 namespace elastic::cli {
 namespace {
@@ -455,7 +456,7 @@ int run_paste(const PasteArgs& a, const CLI::App& sub) {
               << m.metrics.symmetric_dirichlet << ", stretch L2 " << m.metrics.stretch_l2
               << ", folds " << m.metrics.folds << ", " << m.seconds << " s\n";
   }
-  return map_exit_code(*session, a.job.quiet);
+  return finish(judge_map(a.job, *session));
 }
 
 }  // namespace

@@ -14,20 +14,9 @@ namespace {
 MethodMeasurement measure(const MapSession& session, std::string name,
                           const Eigen::Matrix3Xd& positions,
                           const std::vector<SurfacePoint>& points, std::vector<char> outside) {
-  const ParticleGrid& grid = session.result.sampling.grid;
   MethodMeasurement m;
   m.name = std::move(name);
-  MapMetricsOptions options;
-  options.rest_scale = session.result.rest_scale;
-  // A particle without a valid target surface point has no normal and no defined place: it is
-  // treated as outside (the baselines flag theirs; the others have none in practice).
-  outside.resize(points.size(), 0);
-  for (size_t p = 0; p < points.size(); ++p) {
-    if (!points[p].valid()) outside[p] = 1;
-  }
-  options.target_normals = surface_normals(*session.target.surface, points, outside);
-  options.outside = std::move(outside);
-  m.metrics = measure_map(grid, positions, options);
+  m.metrics = measure_placement(session, positions, points, std::move(outside));
   m.positions = positions;
   m.ok = true;
   return m;
@@ -41,16 +30,23 @@ std::vector<MethodMeasurement> compare_methods(const MapSession& session,
   const ParticleGrid& grid = r.sampling.grid;
   std::vector<MethodMeasurement> out;
 
-  MethodMeasurement elastic =
-      measure(session, "elastic", r.relaxation.positions, r.relaxation.points, {});
+  // ElasticPaint and the naive map as the session measured them (the verdict's figures).
+  MethodMeasurement elastic;
+  elastic.name = "elastic";
+  elastic.ok = true;
+  elastic.metrics = session.metrics;
+  elastic.positions = r.relaxation.positions;
   elastic.seconds = r.seconds_naive + r.relaxation.setup_seconds + r.relaxation.solve_seconds;
   elastic.extra = {{"iterations", r.relaxation.iterations},
                    {"converged", r.relaxation.converged},
-                   {"reason", std::string(to_string(r.relaxation.reason))},
-                   {"solver_folded_faces", r.relaxation.folded_faces}};
+                   {"reason", std::string(to_string(r.relaxation.reason))}};
   out.push_back(std::move(elastic));
 
-  MethodMeasurement naive = measure(session, "naive", r.naive.positions, r.naive.points, {});
+  MethodMeasurement naive;
+  naive.name = "naive";
+  naive.ok = true;
+  naive.metrics = session.naive_metrics;
+  naive.positions = r.naive.positions;
   naive.seconds = r.seconds_naive;
   out.push_back(std::move(naive));
 
@@ -118,6 +114,7 @@ nlohmann::json measurement_json(const MethodMeasurement& m) {
   j["conformal_distortion"] = x.conformal_distortion;
   j["symmetric_dirichlet"] = x.symmetric_dirichlet;
   j["folds"] = x.folds;
+  j["sigma_min"] = x.sigma_min;
   j["degenerate"] = x.degenerate;
   j["outside"] = x.outside;
   j["outside_triangles"] = x.outside_triangles;
@@ -126,29 +123,47 @@ nlohmann::json measurement_json(const MethodMeasurement& m) {
   return j;
 }
 
+std::string method_status(const MethodMeasurement& m) {
+  if (!m.ok) return "failed";
+  std::vector<std::string> problems;
+  if (m.extra.contains("converged") && !m.extra["converged"].get<bool>()) {
+    problems.push_back("not converged");
+  }
+  if (m.metrics.folds > 0) {
+    problems.push_back(std::to_string(m.metrics.folds) +
+                       (m.metrics.folds == 1 ? " fold" : " folds"));
+  }
+  if (m.metrics.outside > 0) problems.push_back(std::to_string(m.metrics.outside) + " outside");
+  if (problems.empty()) return "ok";
+  std::string out = "**";
+  for (size_t k = 0; k < problems.size(); ++k) out += (k > 0 ? ", " : "") + problems[k];
+  return out + "**";
+}
+
 std::string markdown_table(const std::vector<MethodMeasurement>& methods) {
   std::ostringstream s;
-  s << "| method | length energy | angle err mean (deg) | angle err max (deg) | stretch L2 | "
-       "stretch Linf | inv. stretch L2 | area dist. | conformal | sym. Dirichlet | folds | "
-       "outside | seconds |\n"
-    << "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+  s << "| method | status | length energy | angle err mean (deg) | angle err max (deg) | "
+       "stretch L2 | stretch Linf | inv. stretch L2 | area dist. | conformal | sym. Dirichlet | "
+       "worst sigma_min | folds | outside | seconds |\n"
+    << "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
   const auto num = [](double v, int digits = 4) {
     std::ostringstream o;
     o << std::setprecision(digits) << v;
     return o.str();
   };
   for (const MethodMeasurement& m : methods) {
-    s << "| " << m.name << " | ";
+    s << "| " << m.name << " | " << method_status(m) << " | ";
     if (!m.ok) {
-      s << "failed: " << m.error << " |||||||||||\n";
+      s << m.error << " |||||||||||||\n";
       continue;
     }
     const MapMetrics& x = m.metrics;
     s << num(x.length_energy) << " | " << num(x.angle_error_mean_deg) << " | "
       << num(x.angle_error_max_deg) << " | " << num(x.stretch_l2) << " | " << num(x.stretch_linf)
       << " | " << num(x.inverse_stretch_l2) << " | " << num(x.area_distortion) << " | "
-      << num(x.conformal_distortion) << " | " << num(x.symmetric_dirichlet) << " | " << x.folds
-      << " | " << x.outside << " | " << num(m.seconds, 3) << " |\n";
+      << num(x.conformal_distortion) << " | " << num(x.symmetric_dirichlet) << " | "
+      << num(x.sigma_min) << " | " << x.folds << " | " << x.outside << " | " << num(m.seconds, 3)
+      << " |\n";
   }
   return s.str();
 }

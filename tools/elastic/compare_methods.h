@@ -46,7 +46,12 @@ std::vector<MethodMeasurement> compare_methods(const MapSession& session,
 /// {"seconds", every aggregate metric key, "error" when failed, plus `extra`}.
 nlohmann::json measurement_json(const MethodMeasurement& m);
 
-/// A Markdown table, one row per method, the headline metrics as columns.
+/// "ok", or what is wrong with the method's map in bold ("**not converged, 3 folds, 2
+/// outside**"), or "failed" (the error is in the next column).
+std::string method_status(const MethodMeasurement& m);
+
+/// A Markdown table, one row per method: its status (folds and failures marked), the headline
+/// metrics as columns.
 std::string markdown_table(const std::vector<MethodMeasurement>& methods);
 
 }  // namespace elastic::cli

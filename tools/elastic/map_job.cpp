@@ -11,6 +11,7 @@
 #include "elastic/core/error.h"
 #include "elastic/regions/region_spec.h"
 #include "job_file.h"
+#include "verdict.h"
 
 namespace elastic::cli {
 namespace {
@@ -28,8 +29,10 @@ nlohmann::json subdivision_report(const MapResult& r) {
                       {"iterations", level.iterations},
                       {"converged", level.converged},
                       {"reason", std::string(to_string(level.reason))},
-                      {"initial_folds", level.initial_folded_faces},
-                      {"folds", level.folded_faces},
+                      // The solver's own fold-guard count on that level's grid (faces with
+                      // a folded corner); the report's `folds` judges the final map.
+                      {"solver_initial_folded_faces", level.initial_folded_faces},
+                      {"solver_folded_faces", level.folded_faces},
                       {"energy_before", level.initial_energy},
                       {"energy", level.energy},
                       {"seconds", level.seconds_subdivide + level.seconds_relax}});
@@ -125,7 +128,8 @@ MapOptions make_map_options(const MapJob& job, const ProgressCallback& progress)
 }
 
 std::unique_ptr<MapSession> run_map_job(const MapJob& job, const ProgressCallback& progress,
-                                        const FrameCallback& frame, long frame_interval) {
+                                        const FrameCallback& frame, long frame_interval,
+                                        SurfaceCache* cache) {
   const auto start = std::chrono::steady_clock::now();
   require_flag(job.target, "--target");
   if (job.particles < 16 || job.particles > 5'000'000) {
@@ -154,10 +158,23 @@ std::unique_ptr<MapSession> run_map_job(const MapJob& job, const ProgressCallbac
                          image_read_options(job));
   }
   if (progress) progress({.stage = "load"});
-  s.source = s.image ? surface_from_mesh(s.image->mesh, job.source_image, job.scheme)
-                     : load_surface(job.source, job.scheme);
+  // A surface from the cache, or loaded (and then cached).
+  const auto surface = [&](const std::string& key, const auto& load) {
+    if (cache == nullptr) return load();
+    const auto found = cache->find(key);
+    if (found != cache->end()) return found->second;
+    return cache->emplace(key, load()).first->second;
+  };
+  s.source =
+      s.image
+          ? surface("image|" + job.source_image + "|" + std::to_string(job.image_width) + "|" +
+                        job.source_region + "|" + job.scheme,
+                    [&] { return surface_from_mesh(s.image->mesh, job.source_image, job.scheme); })
+          : surface("mesh|" + job.source + "|" + job.scheme,
+                    [&] { return load_surface(job.source, job.scheme); });
   print_warnings(s.source.warnings, job.quiet);
-  s.target = load_surface(job.target, job.scheme);
+  s.target = surface("mesh|" + job.target + "|" + job.scheme,
+                     [&] { return load_surface(job.target, job.scheme); });
   print_warnings(s.target.warnings, job.quiet);
 
   RegionSpec source_spec =
@@ -176,6 +193,8 @@ std::unique_ptr<MapSession> run_map_job(const MapJob& job, const ProgressCallbac
   options.relaxation.frame_interval = std::max(1L, frame_interval);
   s.result = map_regions(*s.source.projector, s.source_region, *s.target.projector, s.target_region,
                          options);
+  s.metrics = measure_placement(s, s.result.relaxation.positions, s.result.relaxation.points);
+  s.naive_metrics = measure_placement(s, s.result.naive.positions, s.result.naive.points);
   s.seconds_total = seconds_since(start);
   return session;
 }
@@ -214,10 +233,13 @@ nlohmann::json map_report(const MapJob& job, const MapSession& session,
             {"magnet", x.magnet_energy},
             {"initial", x.initial_energy}}},
           {"gradient", {{"relative", x.relative_gradient}, {"norm", x.gradient_norm}}},
-          {"folds", x.folded_faces},
+          // The one fold count (docs/metrics.md), of the final and of the naive map.
+          {"folds", session.metrics.folds},
+          {"sigma_min", session.metrics.sigma_min},
+          {"initial_folds", session.naive_metrics.folds},
+          {"verdict", judge_map(job, session).to_json()},
           {"held_particles", x.held_particles.size()},
           {"untangle", {{"steps", x.untangle_steps}, {"taken", x.untangled}}},
-          {"initial_folds", x.initial_folded_faces},
           {"boundary_residual", x.boundary_residual},
           {"rest_scale", {{"mode", job.rest_scale}, {"factor", r.rest_scale}}},
           {"boundary", {{"mode", std::string(to_string(x.boundary))}, {"slide", x.boundary_slide}}},
@@ -234,19 +256,19 @@ nlohmann::json map_report(const MapJob& job, const MapSession& session,
             {"density_ratio", s.density_ratio}}}};
 }
 
-int map_exit_code(const MapSession& session, bool quiet) {
-  const RelaxationResult& x = session.result.relaxation;
-  if (x.converged) return kOk;
-  if (x.reason == StopReason::FoldConstrained && x.folded_faces == 0) {
-    if (!quiet) {
-      std::cerr << "elastic: note: the relaxation stopped at its no-fold constraint: "
-                << x.held_particles.size()
-                << " particles are held where moving on would fold a face (the true minimum "
-                   "folds); all others are at equilibrium, and the map has no folds\n";
-    }
-    return kOk;
+MapMetrics measure_placement(const MapSession& session, const Eigen::Matrix3Xd& positions,
+                             const std::vector<SurfacePoint>& points, std::vector<char> outside) {
+  MapMetricsOptions options;
+  options.rest_scale = session.result.rest_scale;
+  // A particle without a valid target surface point has no normal and no defined place: it is
+  // treated as outside (the baselines flag theirs; the others have none in practice).
+  outside.resize(points.size(), 0);
+  for (size_t p = 0; p < points.size(); ++p) {
+    if (!points[p].valid()) outside[p] = 1;
   }
-  return kNumerical;
+  options.target_normals = surface_normals(*session.target.surface, points, outside);
+  options.outside = std::move(outside);
+  return measure_map(session.result.sampling.grid, positions, options);
 }
 
 void write_report(const std::string& path, const nlohmann::json& report) {
@@ -262,8 +284,9 @@ void print_map_summary(const MapJob& job, const MapSession& session) {
             << ", solver " << job.solver << ", " << x.iterations << " iterations, "
             << (x.converged ? "converged" : "NOT converged") << " (" << to_string(x.reason) << ")\n"
             << "length energy " << x.length_energy << ", angle energy " << x.angular_energy
-            << ", relative gradient " << x.relative_gradient << ", folds " << x.folded_faces
-            << ", boundary residual " << x.boundary_residual << '\n'
+            << ", relative gradient " << x.relative_gradient << ", folds " << session.metrics.folds
+            << ", worst sigma_min " << session.metrics.sigma_min << ", boundary residual "
+            << x.boundary_residual << '\n'
             << "seconds: total " << session.seconds_total << ", solve " << x.solve_seconds << '\n';
 }
 

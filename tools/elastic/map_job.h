@@ -11,6 +11,7 @@
 
 #include <CLI/CLI.hpp>
 #include <Eigen/Core>
+#include <map>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <optional>
@@ -18,6 +19,7 @@
 
 #include "cli_common.h"
 #include "elastic/mapping/map_regions.h"
+#include "elastic/metrics/map_metrics.h"
 #include "elastic/regions/image_source.h"
 #include "elastic/regions/region.h"
 
@@ -68,6 +70,10 @@ struct MapSession {
   Region source_region;
   Region target_region;
   MapResult result;
+  /// The final map (result.relaxation) and the naive map measured on the grid by docs/metrics.md:
+  /// the one fold count (`folds`) every report and summary shows, and the verdict's.
+  MapMetrics metrics;
+  MapMetrics naive_metrics;
   double seconds_loading = 0.0;  ///< reading, repairing, limit surfaces, projectors, regions
   double seconds_total = 0.0;    ///< the whole run_map_job
   MapSession() = default;
@@ -79,12 +85,18 @@ struct MapSession {
 /// repeat the map (e.g. `bench` timing several runs).
 MapOptions make_map_options(const MapJob& job, const ProgressCallback& progress = {});
 
+/// Loaded surfaces by file (or image) and scheme, for commands that map many jobs on the same
+/// meshes (`bench robustness`): each is read, repaired and prepared once.
+using SurfaceCache = std::map<std::string, LoadedSurface>;
+
 /// Validates the job, loads the surfaces and regions, and maps. Progress goes to `progress`
 /// (stage and solver iterations). \throws UsageError / InvalidInputError / IoError naming the flag
 /// or file; NumericalError when a stage fails.
-/// `frame` (optional) receives every `frame_interval`-th configuration of the relaxation.
+/// `frame` (optional) receives every `frame_interval`-th configuration of the relaxation. With a
+/// `cache`, surfaces already in it are reused and new ones are added.
 std::unique_ptr<MapSession> run_map_job(const MapJob& job, const ProgressCallback& progress = {},
-                                        const FrameCallback& frame = {}, long frame_interval = 1);
+                                        const FrameCallback& frame = {}, long frame_interval = 1,
+                                        SurfaceCache* cache = nullptr);
 
 /// The report of `elastic map` (keys in docs/getting-started.md) with `job` recorded under "job".
 nlohmann::json map_report(const MapJob& job, const MapSession& session,
@@ -96,11 +108,12 @@ void write_report(const std::string& path, const nlohmann::json& report);
 /// The two-line summary `elastic map` prints.
 void print_map_summary(const MapJob& job, const MapSession& session);
 
-/// The exit code of a map run: 0 when the solver converged, or when it stopped at the no-fold
-/// constraint (FoldConstrained) with zero folds (the map is usable: every particle but the held
-/// ones is at equilibrium; a note on stderr says so unless quiet); 70 (numerical failure)
-/// otherwise.
-int map_exit_code(const MapSession& session, bool quiet);
+/// Measures a placement of the session's particles on the target (docs/metrics.md) with the
+/// session's rest scale and the target's limit-surface normals; particles flagged in `outside` or
+/// without a valid surface point are left out.
+MapMetrics measure_placement(const MapSession& session, const Eigen::Matrix3Xd& positions,
+                             const std::vector<SurfacePoint>& points,
+                             std::vector<char> outside = {});
 
 /// Parses "X,Y,Z" (finite numbers). \throws InvalidInputError naming `flag`.
 Eigen::Vector3d parse_point(const std::string& text, const std::string& flag);

@@ -50,6 +50,77 @@ bool all_finite(const Eigen::Matrix3Xd& m) {
   return m.allFinite();
 }
 
+// The affine map between one source and one target triangle, divided by sigma.
+struct TrianglePair {
+  double source_area = 0.0;
+  double target_area = 0.0;
+  double sum_sq = 0.0;  // s1^2 + s2^2
+  double prod = 0.0;    // s1 s2
+  double s1 = 0.0;
+  double s2 = 0.0;
+  Eigen::Vector3d target_normal = Eigen::Vector3d::Zero();  // (q1 - q0) x (q2 - q0)
+};
+
+// Singular values without a target frame: with S the source edges in an orthonormal frame of the
+// source plane and G_s = S^T S, G_t = T^T T the Gram matrices of the source and target edge vectors
+// (frame-independent dot products of 3D edges), J^T J = S^-T G_t S^-1, hence
+//   s1^2 + s2^2 = trace(J^T J) = trace(G_s^-1 G_t),   s1 s2 = |det J| = A_t / A_s.
+// This also holds for a degenerate target (A_t = 0), where a target frame would not exist.
+// Returns false when the source triangle has zero area.
+bool analyse_pair(const Eigen::Vector3d& p0, const Eigen::Vector3d& p1, const Eigen::Vector3d& p2,
+                  const Eigen::Vector3d& q0, const Eigen::Vector3d& q1, const Eigen::Vector3d& q2,
+                  double sigma, TrianglePair& out) {
+  const Eigen::Vector3d e = p1 - p0, f = p2 - p0, eq = q1 - q0, fq = q2 - q0;
+  const Eigen::Vector3d source_normal = e.cross(f);
+  out.target_normal = eq.cross(fq);
+  out.source_area = 0.5 * source_normal.norm();
+  out.target_area = 0.5 * out.target_normal.norm();
+  if (!(out.source_area > 0.0)) {
+    return false;
+  }
+  Eigen::Matrix2d gs, gt;
+  gs << e.dot(e), e.dot(f), e.dot(f), f.dot(f);
+  gt << eq.dot(eq), eq.dot(fq), eq.dot(fq), fq.dot(fq);
+  // det G_s = |e x f|^2 = (2 A_s)^2 exactly in real arithmetic; use the cross product form, which
+  // has no cancellation for thin triangles.
+  const double det_gs = source_normal.squaredNorm();
+  Eigen::Matrix2d gs_inv;
+  gs_inv << gs(1, 1), -gs(0, 1), -gs(1, 0), gs(0, 0);
+  gs_inv /= det_gs;
+  out.sum_sq = (gs_inv * gt).trace() / (sigma * sigma);
+  out.prod = out.target_area / out.source_area / (sigma * sigma);
+  // s1, s2 from their sum of squares and product: (s1 +- s2)^2 = sum_sq +- 2 prod. The smaller one
+  // as prod / s1 keeps its relative accuracy when s2 << s1.
+  const double plus = std::sqrt(std::max(out.sum_sq + 2.0 * out.prod, 0.0));
+  const double minus = std::sqrt(std::max(out.sum_sq - 2.0 * out.prod, 0.0));
+  out.s1 = 0.5 * (plus + minus);
+  out.s2 = out.s1 > 0.0 ? out.prod / out.s1 : 0.0;
+  return true;
+}
+
+// The triangles of every triangulation of a face with `n` corners that the fold test looks at, as
+// corner positions within the face: a triangle is itself; a quad has two triangulations (the
+// diagonals 0-2 and 1-3), four triangles in all, one per omitted corner; a larger polygon the fans
+// from each of its corners.
+const std::vector<Eigen::Vector3i>& face_triangulations(int n) {
+  static const std::vector<Eigen::Vector3i> triangle = {{0, 1, 2}};
+  static const std::vector<Eigen::Vector3i> quad = {{0, 1, 2}, {0, 2, 3}, {1, 2, 3}, {1, 3, 0}};
+  if (n == 3) {
+    return triangle;
+  }
+  if (n == 4) {
+    return quad;
+  }
+  thread_local std::vector<Eigen::Vector3i> fans;
+  fans.clear();
+  for (int a = 0; a < n; ++a) {
+    for (int k = 1; k + 1 < n; ++k) {
+      fans.emplace_back(a, (a + k) % n, (a + k + 1) % n);
+    }
+  }
+  return fans;
+}
+
 }  // namespace
 
 std::string_view to_string(TriangleMetric metric) {
@@ -103,12 +174,15 @@ const std::vector<double>& TriangleValues::values(TriangleMetric metric) const {
   return s1;
 }
 
-std::vector<Eigen::Vector3i> grid_triangles(const ParticleGrid& grid) {
+std::vector<Eigen::Vector3i> grid_triangles(const ParticleGrid& grid, std::vector<int>* faces) {
   // The same fan as Mapping::triangles(): grid faces are convex in the grid layout (quads of the
   // regular grid, triangles of the boundary band), so any fan is valid; the first corner's is the
   // one the mapping queries use, and using it here makes the heatmap show the mapping's triangles.
   std::vector<Eigen::Vector3i> triangles;
   triangles.reserve(grid.mesh.n_faces() * 2);
+  if (faces != nullptr) {
+    faces->clear();
+  }
   std::vector<int> corners;
   for (const auto fh : grid.mesh.faces()) {
     corners.clear();
@@ -117,6 +191,9 @@ std::vector<Eigen::Vector3i> grid_triangles(const ParticleGrid& grid) {
     }
     for (size_t k = 1; k + 1 < corners.size(); ++k) {
       triangles.emplace_back(corners[0], corners[k], corners[k + 1]);
+      if (faces != nullptr) {
+        faces->push_back(fh.idx());
+      }
     }
   }
   return triangles;
@@ -193,9 +270,11 @@ MapMetrics measure_map(const ParticleGrid& grid, const Eigen::Matrix3Xd& target_
     out.length_energy = den > 0.0 ? num / den : 0.0;
   }
 
-  out.triangles = grid_triangles(grid);
+  out.triangles = grid_triangles(grid, &out.triangle_face);
   const int nt = static_cast<int>(out.triangles.size());
+  const int nf = static_cast<int>(grid.mesh.n_faces());
   TriangleValues& tv = out.per_triangle;
+  FaceValues& fv = out.per_face;
   const double nan = std::numeric_limits<double>::quiet_NaN();
   const double inf = std::numeric_limits<double>::infinity();
   for (auto* v : {&tv.s1, &tv.s2, &tv.source_area, &tv.target_area, &tv.angle_error_deg,
@@ -205,6 +284,65 @@ MapMetrics measure_map(const ParticleGrid& grid, const Eigen::Matrix3Xd& target_
   }
   tv.folded.assign(nt, 0);
   tv.excluded.assign(nt, 0);
+  fv.folded.assign(nf, 0);
+  fv.excluded.assign(nf, 0);
+  fv.sigma_min.assign(nf, nan);
+
+  // The fold test and sigma_min, per grid face over every triangulation of the face
+  // (docs/metrics.md, "Folds"): one split alone can hide an inverted corner. A quad whose corner 0
+  // has moved inside the triangle (1, 2, 3) has two positive triangles along the diagonal 0-2 but
+  // an inverted triangle (1, 3, 0) along the other one.
+  int folds = 0;
+  double worst_sigma = inf;
+  int judged_faces = 0;
+  std::vector<int> corners;
+  for (const auto fh : grid.mesh.faces()) {
+    const int f = fh.idx();
+    corners.clear();
+    for (const auto vh : grid.mesh.fv_range(fh)) {
+      corners.push_back(vh.idx());
+    }
+    bool excluded = false;
+    for (const int c : corners) {
+      excluded = excluded || skip[c] != 0;
+    }
+    if (excluded) {
+      fv.excluded[f] = 1;
+      continue;
+    }
+    bool folded = false, degenerate = false;
+    double sigma_min = inf;
+    for (const Eigen::Vector3i& local : face_triangulations(static_cast<int>(corners.size()))) {
+      const int a = corners[local[0]], b = corners[local[1]], c = corners[local[2]];
+      TrianglePair pair;
+      if (!analyse_pair(source.col(a), source.col(b), source.col(c), target_positions.col(a),
+                        target_positions.col(b), target_positions.col(c), sigma, pair)) {
+        throw InvalidInputError(
+            name, "grid face " + std::to_string(f) + " has a zero-area triangle on the source");
+      }
+      const bool flat = !(pair.prod >= options.degenerate_area_ratio);
+      bool inverted = false;
+      if (have_normals) {
+        // Inverted when the target triangle's normal points against the surface: compare with the
+        // sum of the three corners' unit normals (robust to one corner normal being off).
+        const Eigen::Vector3d surface_normal = options.target_normals.col(a) +
+                                               options.target_normals.col(b) +
+                                               options.target_normals.col(c);
+        inverted = pair.target_normal.dot(surface_normal) <= 0.0;
+      }
+      degenerate = degenerate || flat;
+      folded = folded || flat || inverted;
+      // The signed smallest singular value: negative for an inverted triangle (det J < 0).
+      sigma_min = std::min(sigma_min, inverted ? -pair.s2 : pair.s2);
+    }
+    fv.folded[f] = folded ? 1 : 0;
+    fv.sigma_min[f] = sigma_min;
+    folds += folded ? 1 : 0;
+    out.degenerate += degenerate ? 1 : 0;
+    worst_sigma = std::min(worst_sigma, sigma_min);
+    ++judged_faces;
+  }
+  out.sigma_min = judged_faces > 0 ? worst_sigma : nan;
 
   double w_sum = 0.0, w_stretch = 0.0, w_area = 0.0, w_conf = 0.0, w_sd = 0.0;
   double w_inv_sum = 0.0, w_inv_stretch = 0.0;
@@ -212,7 +350,6 @@ MapMetrics measure_map(const ParticleGrid& grid, const Eigen::Matrix3Xd& target_
   double max_s1 = 0.0, max_inv = 0.0;
   double angle_sum = 0.0;
   long angle_count = 0;
-  int folds = 0;
   constexpr double kDeg = 180.0 / std::numbers::pi;
 
   for (int t = 0; t < nt; ++t) {
@@ -222,40 +359,19 @@ MapMetrics measure_map(const ParticleGrid& grid, const Eigen::Matrix3Xd& target_
       ++out.outside_triangles;
       continue;
     }
-    const Eigen::Vector3d p0 = source.col(tri[0]), p1 = source.col(tri[1]), p2 = source.col(tri[2]);
-    const Eigen::Vector3d q0 = target_positions.col(tri[0]), q1 = target_positions.col(tri[1]),
-                          q2 = target_positions.col(tri[2]);
-    const Eigen::Vector3d e = p1 - p0, f = p2 - p0, eq = q1 - q0, fq = q2 - q0;
-    const Eigen::Vector3d source_normal = e.cross(f), target_normal = eq.cross(fq);
-    const double source_area = 0.5 * source_normal.norm();
-    const double target_area = 0.5 * target_normal.norm();
-    if (!(source_area > 0.0)) {
+    TrianglePair pair;
+    if (!analyse_pair(source.col(tri[0]), source.col(tri[1]), source.col(tri[2]),
+                      target_positions.col(tri[0]), target_positions.col(tri[1]),
+                      target_positions.col(tri[2]), sigma, pair)) {
       throw InvalidInputError(
           name, "grid triangle " + std::to_string(t) + " has zero area on the source");
     }
-
-    // Singular values without a target frame: with S the source edges in an orthonormal frame of
-    // the source plane and G_s = S^T S, G_t = T^T T the Gram matrices of the source and target
-    // edge vectors (frame-independent dot products of 3D edges), J^T J = S^-T G_t S^-1, hence
-    //   s1^2 + s2^2 = trace(J^T J) = trace(G_s^-1 G_t),   s1 s2 = |det J| = A_t / A_s.
-    // This also holds for a degenerate target (A_t = 0), where a target frame would not exist.
-    Eigen::Matrix2d gs, gt;
-    gs << e.dot(e), e.dot(f), e.dot(f), f.dot(f);
-    gt << eq.dot(eq), eq.dot(fq), eq.dot(fq), fq.dot(fq);
-    // det G_s = |e x f|^2 = (2 A_s)^2 exactly in real arithmetic; use the cross product form,
-    // which has no cancellation for thin triangles.
-    const double det_gs = source_normal.squaredNorm();
-    Eigen::Matrix2d gs_inv;
-    gs_inv << gs(1, 1), -gs(0, 1), -gs(1, 0), gs(0, 0);
-    gs_inv /= det_gs;
-    const double sum_sq = (gs_inv * gt).trace() / (sigma * sigma);    // s1^2 + s2^2
-    const double prod = target_area / source_area / (sigma * sigma);  // s1 s2
-    // s1, s2 from their sum of squares and product: (s1 +- s2)^2 = sum_sq +- 2 prod. The smaller
-    // one as prod / s1 keeps its relative accuracy when s2 << s1.
-    const double plus = std::sqrt(std::max(sum_sq + 2.0 * prod, 0.0));
-    const double minus = std::sqrt(std::max(sum_sq - 2.0 * prod, 0.0));
-    const double s1 = 0.5 * (plus + minus);
-    const double s2 = s1 > 0.0 ? prod / s1 : 0.0;
+    const double sum_sq = pair.sum_sq;  // s1^2 + s2^2
+    const double prod = pair.prod;      // s1 s2
+    const double s1 = pair.s1;
+    const double s2 = pair.s2;
+    const double source_area = pair.source_area;
+    const double target_area = pair.target_area;
 
     tv.s1[t] = s1;
     tv.s2[t] = s2;
@@ -263,19 +379,9 @@ MapMetrics measure_map(const ParticleGrid& grid, const Eigen::Matrix3Xd& target_
     tv.target_area[t] = target_area;
     tv.stretch_l2[t] = std::sqrt(0.5 * sum_sq);
 
+    // A triangle shows its face's fold (either triangulation); its own values need an inverse.
     const bool degenerate = !(prod >= options.degenerate_area_ratio);
-    bool folded = degenerate;
-    if (!degenerate && have_normals) {
-      // Inverted when the target triangle's normal points against the surface: compare with the
-      // sum of the three corners' unit normals (robust to one corner normal being off).
-      const Eigen::Vector3d surface_normal = options.target_normals.col(tri[0]) +
-                                             options.target_normals.col(tri[1]) +
-                                             options.target_normals.col(tri[2]);
-      folded = target_normal.dot(surface_normal) <= 0.0;
-    }
-    tv.folded[t] = folded ? 1 : 0;
-    folds += folded ? 1 : 0;
-    out.degenerate += degenerate ? 1 : 0;
+    tv.folded[t] = fv.folded[out.triangle_face[t]];
 
     // Corner angles (unsigned, in each triangle's own plane).
     double worst = 0.0;

@@ -16,6 +16,14 @@
 /// Both frames follow the triangles' own orientation, so det J > 0 always: inversion is detected
 /// separately, against the target surface normal (`folds`).
 ///
+/// Folds, the one definition (docs/metrics.md): a triangle is inverted when its target normal
+/// (q1 - q0) x (q2 - q0) has a non-positive dot product with the sum of the unit surface normals
+/// at its corners, or degenerate. A grid *face* is folded when a triangle of *either*
+/// triangulation of it is inverted or degenerate (a quad: the four triangles of its two diagonal
+/// splits; a triangle: itself), since the fan alone hides a quad whose first or third corner has
+/// moved inside. `folds` counts folded faces; `sigma_min` is the smallest signed singular value of
+/// J / sigma over the same triangles (negative on an inverted one).
+///
 /// Scale: the Jacobian is divided by the rest scale sigma (the uniform scale the map is meant to
 /// have, `MapMetricsOptions::rest_scale`, e.g. MapResult::rest_scale), so a map that is exactly
 /// the similarity of scale sigma has s1 = s2 = 1. Use sigma = 1 to measure absolute lengths.
@@ -23,7 +31,7 @@
 /// Aggregates are weighted by source triangle areas (the forward map's domain) unless said
 /// otherwise; the inverse stretch (target -> source) is weighted by target areas (its domain).
 /// Triangles with a corner flagged `outside` are excluded from every aggregate and counted;
-/// triangles whose target is degenerate (zero area: no Jacobian inverse) are counted as folds and
+/// triangles whose target is degenerate (zero area: no Jacobian inverse) fold their face and are
 /// excluded from the aggregates that divide by s2.
 
 #include <Eigen/Core>
@@ -72,20 +80,31 @@ struct MapMetricsOptions {
 
 /// Per-triangle values, all of size #T (the triangles of `MapMetrics::triangles`).
 struct TriangleValues {
-  std::vector<double> s1;           ///< larger singular value of J / sigma
-  std::vector<double> s2;           ///< smaller singular value of J / sigma (>= 0)
-  std::vector<double> source_area;  ///< source triangle area (the weight)
-  std::vector<double> target_area;  ///< target triangle area
-  std::vector<char> folded;         ///< 1: target inverted w.r.t. the surface normal, or degenerate
-  std::vector<char> excluded;       ///< 1: a corner is outside (no values: NaN)
-  std::vector<double> angle_error_deg;       ///< max over the 3 corners of |target - source angle|
-  std::vector<double> stretch_l2;            ///< sqrt((s1^2 + s2^2) / 2)
+  std::vector<double> s1;               ///< larger singular value of J / sigma
+  std::vector<double> s2;               ///< smaller singular value of J / sigma (>= 0)
+  std::vector<double> source_area;      ///< source triangle area (the weight)
+  std::vector<double> target_area;      ///< target triangle area
+  std::vector<char> folded;             ///< 1: the triangle's face is folded (FaceValues::folded)
+  std::vector<char> excluded;           ///< 1: a corner is outside (no values: NaN)
+  std::vector<double> angle_error_deg;  ///< max over the 3 corners of |target - source angle|
+  std::vector<double> stretch_l2;       ///< sqrt((s1^2 + s2^2) / 2)
   std::vector<double> inverse_stretch_l2;    ///< sqrt((s1^-2 + s2^-2) / 2) (+inf if degenerate)
   std::vector<double> area_distortion;       ///< |log(s1 s2)| (+inf if degenerate)
   std::vector<double> conformal_distortion;  ///< s1 / s2 (+inf if degenerate)
   std::vector<double> symmetric_dirichlet;   ///< s1^2 + s2^2 + s1^-2 + s2^-2 (+inf if degenerate)
   /// The values of one metric (s1 for StretchLinf).
   const std::vector<double>& values(TriangleMetric metric) const;
+};
+
+/// Per grid face values, all of size #F (the grid's faces in index order).
+struct FaceValues {
+  /// 1: a triangle of either triangulation of the face is inverted w.r.t. the surface normal, or
+  /// degenerate (the definition of a fold).
+  std::vector<char> folded;
+  /// The smallest signed singular value of J / sigma over the triangles of both triangulations:
+  /// s2 of a well-oriented triangle, -s2 of an inverted one. NaN for an excluded face.
+  std::vector<double> sigma_min;
+  std::vector<char> excluded;  ///< 1: a corner is outside (not judged)
 };
 
 /// The aggregates that reports carry (docs/metrics.md has every formula).
@@ -110,10 +129,15 @@ struct MapMetrics {
   double conformal_distortion = 1.0;
   /// sum A (s1^2 + s2^2 + s1^-2 + s2^-2) / sum A. 4 is perfect.
   double symmetric_dirichlet = 4.0;
-  /// Triangles inverted relative to the target surface normal (degenerate ones included); -1 when
-  /// no normals were given (not measured).
+  /// Folded grid faces: faces with a triangle, in either of their triangulations, inverted
+  /// relative to the target surface normal or degenerate (FaceValues::folded); -1 when no normals
+  /// were given (not measured; only degenerate triangles are then flagged per face).
   int folds = 0;
-  int degenerate = 0;          ///< triangles with a degenerate target (counted in `folds` too)
+  /// The worst triangle: the smallest signed singular value of J / sigma over both triangulations
+  /// of every judged face (FaceValues::sigma_min); 1 for a similarity of scale sigma, <= 0 for a
+  /// collapsed or inverted triangle. NaN when no face is judged.
+  double sigma_min = 1.0;
+  int degenerate = 0;          ///< faces with a degenerate target triangle (counted in `folds`)
   int outside = 0;             ///< particles flagged outside
   int outside_triangles = 0;   ///< triangles excluded because a corner is outside
   int measured_triangles = 0;  ///< triangles in the aggregates
@@ -121,13 +145,18 @@ struct MapMetrics {
 
   /// The grid's triangles (particle index triples, counter-clockwise on the source).
   std::vector<Eigen::Vector3i> triangles;
+  /// #T: the grid face each triangle comes from.
+  std::vector<int> triangle_face;
   /// Per-triangle values for heatmaps.
   TriangleValues per_triangle;
+  /// Per-face fold flags and sigma_min.
+  FaceValues per_face;
 };
 
 /// The grid's faces split into triangles, fanned from each face's first corner (the split of
-/// `Mapping::triangles()`).
-std::vector<Eigen::Vector3i> grid_triangles(const ParticleGrid& grid);
+/// `Mapping::triangles()`). `faces`, when given, receives each triangle's face index.
+std::vector<Eigen::Vector3i> grid_triangles(const ParticleGrid& grid,
+                                            std::vector<int>* faces = nullptr);
 
 /// Measures the map grid source positions -> `target_positions` (3 x #P).
 /// \throws InvalidInputError when sizes disagree (naming them), the grid has no faces or no built
