@@ -50,8 +50,9 @@ MapVerdict judge_map(const MapJob& job, const MapSession& session) {
   v.failure = failed.size() == 2 ? failed[0] + " and " + failed[1] : failed[0];
 
   // Suggestions that apply to this job: a larger budget when the budget ran out; for a rectangle
-  // image its inscribed ellipse (corners are the hardest boundary); the area rest scale when the
-  // boundary ratio is in use (it spreads compression instead of buckling); a sliding boundary.
+  // image its inscribed ellipse (corners are the hardest boundary); the robust energy instead of
+  // the paper's; the area rest scale unless in use (it spreads compression instead of buckling);
+  // the other boundary mode.
   std::vector<std::string> advice;
   if (x.reason == StopReason::MaxIterations) {
     advice.push_back(job.max_iterations > 0
@@ -61,8 +62,9 @@ MapVerdict judge_map(const MapJob& job, const MapSession& session) {
   if (!job.source_image.empty() && job.source_region != "ellipse") {
     advice.push_back("--source-region ellipse");
   }
-  if (job.rest_scale == "boundary") advice.push_back("--rest-scale area");
-  advice.push_back("--boundary slide");
+  if (job.energy == "paper") advice.push_back("--energy robust");
+  if (job.rest_scale != "area") advice.push_back("--rest-scale area");
+  advice.push_back(job.boundary == "slide" ? "--boundary fixed" : "--boundary slide");
   v.advice = join_choices(advice);
   return v;
 }
