@@ -47,6 +47,36 @@ TEST(MapRegions, PlaneOntoRigidlyMovedCopyIsTheRigidMotion) {
   EXPECT_NEAR(result.rest_scale, 1.0, 1e-9);
 }
 
+// Without anchors the correspondence's start is chosen (MapOptions::choose_offset): the whole
+// 4 x 2 rectangle of a stretched plane onto a copy turned by 90 degrees about its centre. The
+// automatic anchors both lie along world +x from the centre: the middle of a short side on the
+// source, of a long side on the target, 3/12 of the perimeter apart. The offset that undoes this
+// (a quarter of the boundary, one of the 24 candidates) makes the map the turn itself; keeping the
+// anchors leaves a correspondence no relaxation with a fixed boundary can undo.
+TEST(MapRegions, ChosenOffsetUndoesATurnWithoutAnchors) {
+  PolygonMesh plane = make_plane({.faces = ShapeFaces::Quads, .resolution = 12});
+  for (Eigen::Vector3d& p : plane.positions) p.x() *= 2.0;
+  const Eigen::Isometry3d turn(Eigen::AngleAxisd(0.5 * std::acos(-1.0), Eigen::Vector3d::UnitZ()));
+  const LimitSurface source_surface(plane), target_surface(test::moved(plane, turn));
+  const SurfaceProjector source(source_surface), target(target_surface);
+  const Region from = make_region(source, parse_region_spec("boundary"));
+  const Region to = make_region(target, parse_region_spec("boundary"));
+  ASSERT_FALSE(from.anchor_given);
+  MapOptions options;
+  options.sampling.layout.particles = 400;
+  const MapResult result = map_regions(source, from, target, to, options);
+  EXPECT_TRUE(result.offset_chosen);
+  EXPECT_NEAR(std::min(result.boundary_offset, 1.0 - result.boundary_offset), 0.25, 1e-12);
+  EXPECT_LT(result.offset_energy, 1e-6 * result.offset_energy_at_zero);
+  ASSERT_TRUE(result.relaxation.converged) << to_string(result.relaxation.reason);
+  const Eigen::Matrix3Xd expected = turn * result.sampling.grid.source_positions();
+  EXPECT_LT((result.relaxation.positions - expected).colwise().norm().maxCoeff(), 1e-6);
+  options.choose_offset = false;
+  const MapResult kept = map_regions(source, from, target, to, options);
+  EXPECT_FALSE(kept.offset_chosen);
+  EXPECT_GT(kept.relaxation.length_energy, 1e3 * result.relaxation.length_energy + 1e-9);
+}
+
 // The whole plane square onto the cap: converges, no folds, boundary particles exactly where the
 // arc-length correspondence put them, and relaxation lowers the energy of the naive map.
 TEST(MapRegions, PlaneOntoCapConvergesWithoutFolds) {
