@@ -2,6 +2,7 @@
 
 #include <tbb/task_arena.h>
 
+#include <algorithm>
 #include <string>
 
 #include "elastic/core/error.h"
@@ -150,7 +151,8 @@ RelaxationResult relax_fast_paper(const RelaxationProblem& problem,
 // from collapse, but it cannot be crossed, so a start with folded faces (the naive map folds a few
 // under extreme compression) is first untangled with the paper's energy (relax_fast_paper), and
 // the barrier run starts again from that fold-free state.
-RelaxationResult relax_fast(const RelaxationProblem& problem, const RelaxationOptions& options) {
+RelaxationResult relax_fast_energy(const RelaxationProblem& problem,
+                                   const RelaxationOptions& options) {
   if (options.energy == EnergyKind::Paper) {
     return relax_fast_paper(problem, options);
   }
@@ -182,6 +184,52 @@ RelaxationResult relax_fast(const RelaxationProblem& problem, const RelaxationOp
   result.untangle_steps = paper.untangle_steps;
   result.untangled = paper.untangled;
   result.untangle_phases = 1;
+  return result;
+}
+
+// Fast mode. With a sliding boundary: first the boundary particles slide along the curve with the
+// interior (up to kSlideIterations iterations: the curve is only piecewise smooth, a kink at each
+// of its vertices, so the last digits of that stationarity come slowly), then the boundary is held
+// where it slid and the interior relaxes to the tolerance, a smooth problem. The verdict is the
+// second phase's.
+constexpr long kSlideIterations = 500;
+
+RelaxationResult relax_fast(const RelaxationProblem& problem, const RelaxationOptions& options) {
+  if (options.boundary != BoundaryMode::Slide) {
+    return relax_fast_energy(problem, options);
+  }
+  RelaxationOptions sliding = options;
+  sliding.max_iterations =
+      options.max_iterations > 0 ? std::min(options.max_iterations, kSlideIterations)
+                                 : kSlideIterations;
+  const RelaxationResult slid = relax_fast_energy(problem, sliding);
+  if (slid.reason == StopReason::Cancelled || slid.positions.cols() == 0) {
+    return slid;
+  }
+  RelaxationProblem held = problem;
+  held.initial_positions = slid.positions;
+  held.initial_points = slid.points;
+  held.boundary_parameters = slid.boundary_parameters;
+  const std::vector<int>& loop = problem.grid->boundary_loop;
+  held.boundary_targets.resize(3, static_cast<Eigen::Index>(loop.size()));
+  for (std::size_t k = 0; k < loop.size(); ++k) {
+    held.boundary_targets.col(static_cast<Eigen::Index>(k)) = slid.positions.col(loop[k]);
+  }
+  RelaxationOptions fixed = options;
+  fixed.boundary = BoundaryMode::Fixed;
+  RelaxationResult result = relax_fast_energy(held, fixed);
+  result.boundary = BoundaryMode::Slide;
+  result.boundary_slide = slid.boundary_slide;
+  result.slide_iterations = slid.iterations;
+  result.slide_reason = slid.reason;
+  result.initial_energy = slid.initial_energy;
+  result.initial_folded_faces = slid.initial_folded_faces;
+  result.iterations += slid.iterations;
+  result.evaluations += slid.evaluations;
+  result.setup_seconds += slid.setup_seconds;
+  result.solve_seconds += slid.solve_seconds;
+  result.untangle_phases += slid.untangle_phases;
+  result.untangle_steps += slid.untangle_steps;
   return result;
 }
 

@@ -121,7 +121,8 @@ enum class BoundaryMode {
   /// They stay where the boundary correspondence put them (the paper's arc-length boundary, §4.1).
   Fixed,
   /// They stay on the target curve, in order, and slide along it to lower the energy (fast solver;
-  /// needs RelaxationProblem::boundary_curve). The faithful solver keeps them fixed.
+  /// needs RelaxationProblem::boundary_curve), then are held there while the interior settles
+  /// (RelaxationResult::slide_iterations). The faithful solver keeps them fixed.
   Slide
 };
 /// "fixed", "slide".
@@ -245,6 +246,12 @@ struct RelaxationResult {
   std::vector<double> boundary_parameters;
   /// Largest distance a boundary particle slid, as a fraction of the curve (0 when fixed).
   double boundary_slide = 0.0;
+  /// BoundaryMode::Slide runs in two phases: the boundary slides with the interior (at most 500
+  /// iterations), then it is held where it slid while the interior relaxes to the tolerance (the
+  /// result's `reason`, `converged` and gradients are that second phase's). The first phase's
+  /// iterations (counted in `iterations` too) and why it stopped:
+  long slide_iterations = 0;
+  StopReason slide_reason = StopReason::MaxIterations;
   double rest_scale = 1.0;                      ///< sigma used
   RestScale rest_scale_mode = RestScale::Auto;  ///< its mode, as given
   // Explicit integrator parameters actually used (0 for L-BFGS).
