@@ -208,9 +208,9 @@ TEST(Cli, ForcedFailureHasOneVerdictAcrossMapCompareAndPaste) {
               0u)
         << run.err;
     // What to try: a budget above the one given, the ellipse for a rectangle image, the area
-    // rest scale (the default is auto), a sliding boundary (the default is fixed).
+    // rest scale (the default is auto), the fixed boundary (the default slides).
     for (const char* advice : {"--max-iterations above 1", "--source-region ellipse",
-                               "--rest-scale area", "--boundary slide"}) {
+                               "--rest-scale area", "--boundary fixed"}) {
       EXPECT_NE(run.err.find(advice), std::string::npos) << advice << " not in " << run.err;
     }
   };

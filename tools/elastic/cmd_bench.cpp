@@ -91,6 +91,7 @@ nlohmann::json run_case(const nlohmann::json& c, const BenchArgs& args) {
   job.energy = "paper";
   job.rest_scale = "boundary";
   job.boundary_offset = "anchor";
+  job.boundary = "fixed";
 
   if (!args.quiet) std::cerr << "elastic bench: " << name << " run 1\n";
   const std::unique_ptr<MapSession> session = run_map_job(job);

@@ -83,9 +83,10 @@ void add_map_flags(CLI::App& sub, MapJob& a) {
                  "auto (default: the smaller of boundary and area) | boundary | area | none")
       ->check(CLI::IsMember({"auto", "boundary", "area", "none"}));
   sub.add_option("--boundary", a.boundary,
-                 "fixed (the paper's arc-length boundary) or slide (boundary particles move "
-                 "along the target curve, in order, to lower the energy)")
-      ->check(CLI::IsMember({"fixed", "slide"}));
+                 "auto (default: slide, or fixed with --subdivide), fixed (the paper's arc-length "
+                 "boundary) or slide (boundary particles move along the target curve, in order, "
+                 "to lower the energy)")
+      ->check(CLI::IsMember({"auto", "fixed", "slide"}));
   sub.add_option("--boundary-offset", a.boundary_offset,
                  "auto (default: turn the correspondence to the least naive-map energy when no "
                  "anchor is given) or anchor (start at the regions' anchors)")
@@ -116,7 +117,11 @@ MapOptions make_map_options(const MapJob& job, const ProgressCallback& progress)
   options.relaxation.solver = job.solver == "explicit" ? SolverKind::Faithful : SolverKind::Fast;
   options.relaxation.energy = parse_energy_kind(job.energy, "--energy");
   options.choose_offset = job.boundary_offset == "auto";
-  options.relaxation.boundary = parse_boundary_mode(job.boundary, "--boundary");
+  // auto: slide, except with --subdivide (refinement places new boundary particles by the source
+  // parameters, so it needs the fixed correspondence).
+  options.relaxation.boundary =
+      job.boundary == "auto" ? (job.subdivide > 0 ? BoundaryMode::Fixed : BoundaryMode::Slide)
+                             : parse_boundary_mode(job.boundary, "--boundary");
   options.relaxation.lbfgs.preconditioner =
       parse_preconditioner(job.preconditioner, "--preconditioner");
   options.relaxation.threads = job.threads;

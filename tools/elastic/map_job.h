@@ -40,7 +40,7 @@ struct MapJob {
   std::string rest_scale = "auto";           ///< --rest-scale auto|boundary|area|none
   std::string energy = "robust";             ///< --energy robust|paper
   std::string boundary_offset = "auto";      ///< --boundary-offset auto|anchor
-  std::string boundary = "fixed";            ///< --boundary fixed|slide
+  std::string boundary = "auto";             ///< --boundary auto|fixed|slide
   std::string scheme = "auto";               ///< --scheme auto|loop|catmull-clark
   int subdivide = 0;                         ///< --subdivide K: refinement levels after the map
   int threads = 0;                           ///< --threads N (0: all)

@@ -64,7 +64,7 @@ MapVerdict judge_map(const MapJob& job, const MapSession& session) {
   }
   if (job.energy == "paper") advice.push_back("--energy robust");
   if (job.rest_scale != "area") advice.push_back("--rest-scale area");
-  advice.push_back(job.boundary == "slide" ? "--boundary fixed" : "--boundary slide");
+  advice.push_back(job.boundary == "fixed" ? "--boundary slide" : "--boundary fixed");
   v.advice = join_choices(advice);
   return v;
 }
