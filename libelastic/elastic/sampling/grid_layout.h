@@ -73,8 +73,8 @@ struct GridLayoutResult {
   /// Free particles added inside the band where a triangle would have had every corner on the
   /// boundary (counted in interior_particles; numbered after the lattice points).
   int band_points = 0;
-  double count_error = 0.0;    ///< (particles - N) / N
-  int search_steps = 0;        ///< lattice counts done by the spacing search
+  double count_error = 0.0;  ///< (particles - N) / N
+  int search_steps = 0;      ///< lattice counts done by the spacing search
   FlatteningMethod flattening = FlatteningMethod::Conformal;  ///< the flattening actually used
   /// #P position of each particle in the scaled flattened plane.
   std::vector<Eigen::Vector2d> flat_positions;

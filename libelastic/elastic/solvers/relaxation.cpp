@@ -199,9 +199,9 @@ RelaxationResult relax_fast(const RelaxationProblem& problem, const RelaxationOp
     return relax_fast_energy(problem, options);
   }
   RelaxationOptions sliding = options;
-  sliding.max_iterations =
-      options.max_iterations > 0 ? std::min(options.max_iterations, kSlideIterations)
-                                 : kSlideIterations;
+  sliding.max_iterations = options.max_iterations > 0
+                               ? std::min(options.max_iterations, kSlideIterations)
+                               : kSlideIterations;
   const RelaxationResult slid = relax_fast_energy(problem, sliding);
   if (slid.reason == StopReason::Cancelled || slid.positions.cols() == 0) {
     return slid;
