@@ -77,17 +77,27 @@ TEST(MapRegions, ChosenOffsetUndoesATurnWithoutAnchors) {
   EXPECT_GT(kept.relaxation.length_energy, 1e3 * result.relaxation.length_energy + 1e-9);
 }
 
+// The whole plane square onto the whole cap (600 particles): the case of the two tests below.
+struct SquareOntoCap {
+  LimitSurface source_surface{make_plane({.resolution = 8})};
+  LimitSurface target_surface{make_cap({.resolution = 16})};
+  SurfaceProjector source{source_surface}, target{target_surface};
+  Region from = make_region(source, parse_region_spec("boundary"));
+  Region to = make_region(target, parse_region_spec("boundary"));
+  MapOptions options = [] {
+    MapOptions o;
+    o.sampling.layout.particles = 600;
+    return o;
+  }();
+};
+
 // The whole plane square onto the cap: converges, no folds, boundary particles exactly where the
 // arc-length correspondence put them, and relaxation lowers the energy of the naive map.
 TEST(MapRegions, PlaneOntoCapConvergesWithoutFolds) {
-  const LimitSurface source_surface(make_plane({.resolution = 8}));
-  const LimitSurface target_surface(make_cap({.resolution = 16}));
-  const SurfaceProjector source(source_surface), target(target_surface);
-  const Region from = make_region(source, parse_region_spec("boundary"));
-  const Region to = make_region(target, parse_region_spec("boundary"));
-  MapOptions options;
-  options.sampling.layout.particles = 600;
-  const MapResult result = map_regions(source, from, target, to, options);
+  SquareOntoCap c;
+  const LimitSurface& target_surface = c.target_surface;
+  MapOptions& options = c.options;
+  const MapResult result = map_regions(c.source, c.from, c.target, c.to, options);
   const RelaxationResult& r = result.relaxation;
   EXPECT_TRUE(r.converged) << to_string(r.reason);
   EXPECT_EQ(r.folded_faces, 0);
@@ -100,25 +110,18 @@ TEST(MapRegions, PlaneOntoCapConvergesWithoutFolds) {
   }
 }
 
-// Forward then inverse returns near the start (both directions are the grid's affine map per
-// triangle; they differ only by the magnet's step off the particles' chord planes on the cylinder,
-// see mapping_test.cpp for the bound), and points outside the region answer "outside".
 // --boundary slide: the plane's square (four corners, where the fixed arc-length boundary forces
 // the most distortion) onto the cap's round boundary. Every boundary particle stays on the target
 // curve at its parameter (checked here against the disk map's curve point, not the solver's own
 // residual), the particles keep their order along the curve, some do slide, and the energy ends
 // below the fixed boundary's.
 TEST(MapRegions, SlidingBoundaryStaysOnTheCurveInOrder) {
-  const LimitSurface source_surface(make_plane({.resolution = 8}));
-  const LimitSurface target_surface(make_cap({.resolution = 16}));
-  const SurfaceProjector source(source_surface), target(target_surface);
-  const Region from = make_region(source, parse_region_spec("boundary"));
-  const Region to = make_region(target, parse_region_spec("boundary"));
-  MapOptions options;
-  options.sampling.layout.particles = 600;
-  const MapResult fixed = map_regions(source, from, target, to, options);
+  SquareOntoCap c;
+  const LimitSurface& target_surface = c.target_surface;
+  MapOptions& options = c.options;
+  const MapResult fixed = map_regions(c.source, c.from, c.target, c.to, options);
   options.relaxation.boundary = BoundaryMode::Slide;
-  const MapResult slid = map_regions(source, from, target, to, options);
+  const MapResult slid = map_regions(c.source, c.from, c.target, c.to, options);
   const RelaxationResult& r = slid.relaxation;
   EXPECT_TRUE(r.converged) << to_string(r.reason);
   EXPECT_EQ(r.folded_faces, 0);
@@ -145,6 +148,9 @@ TEST(MapRegions, SlidingBoundaryStaysOnTheCurveInOrder) {
                 fixed.relaxation.barrier_energy);
 }
 
+// Forward then inverse returns near the start (both directions are the grid's affine map per
+// triangle; they differ only by the magnet's step off the particles' chord planes on the cylinder,
+// see mapping_test.cpp for the bound), and points outside the region answer "outside".
 TEST(MapRegions, MappingAnswersBothWays) {
   const LimitSurface source_surface(make_plane({.resolution = 8}));
   const LimitSurface target_surface(make_cylinder({.resolution = 24}));

@@ -218,6 +218,20 @@ RelaxationResult relax_fast(const RelaxationProblem& problem, const RelaxationOp
   RelaxationOptions fixed = options;
   fixed.boundary = BoundaryMode::Fixed;
   RelaxationResult result = relax_fast_energy(held, fixed);
+  if (!result.converged || result.folded_faces > 0) {
+    // The slid state did not settle (the slide stopped somewhere the interior cannot relax
+    // from): the fixed boundary from the original start instead, when that converges fold-free.
+    RelaxationResult plain = relax_fast_energy(problem, fixed);
+    if (plain.converged && plain.folded_faces == 0) {
+      plain.slide_iterations = slid.iterations;
+      plain.slide_reason = slid.reason;
+      plain.iterations += slid.iterations + result.iterations;
+      plain.evaluations += slid.evaluations + result.evaluations;
+      plain.setup_seconds += slid.setup_seconds + result.setup_seconds;
+      plain.solve_seconds += slid.solve_seconds + result.solve_seconds;
+      return plain;  // boundary = Fixed: the report says the slide was not kept
+    }
+  }
   result.boundary = BoundaryMode::Slide;
   result.boundary_slide = slid.boundary_slide;
   result.slide_iterations = slid.iterations;

@@ -249,7 +249,10 @@ struct RelaxationResult {
   /// BoundaryMode::Slide runs in two phases: the boundary slides with the interior (at most 500
   /// iterations), then it is held where it slid while the interior relaxes to the tolerance (the
   /// result's `reason`, `converged` and gradients are that second phase's). The first phase's
-  /// iterations (counted in `iterations` too) and why it stopped:
+  /// iterations (counted in `iterations` too) and why it stopped. When the held second phase does
+  /// not converge fold-free, the fixed boundary from the original start is run and taken if it
+  /// does; `boundary` then says Fixed.
+  /// The slide phase's iterations and why it stopped:
   long slide_iterations = 0;
   StopReason slide_reason = StopReason::MaxIterations;
   double rest_scale = 1.0;                      ///< sigma used
