@@ -145,7 +145,11 @@ MeshReadResult read_ascii_stl(const std::string& text, const std::filesystem::pa
       in_loop = true;
       loop.clear();
     } else if (in_loop && (keyword == "endfacet" || keyword == "facet" || keyword == "endsolid")) {
-      scanner.fail("'" + std::string(keyword) + "' inside a loop: the facet has no 'endloop'");
+      // Built by appending: GCC 12 reports a false -Wrestrict on the operator+ chain here.
+      std::string message = "'";
+      message.append(keyword);
+      message.append("' inside a loop: the facet has no 'endloop'");
+      scanner.fail(message);
     } else if (keyword == "endloop") {
       if (!in_loop) {
         scanner.fail("'endloop' without 'outer loop'");
