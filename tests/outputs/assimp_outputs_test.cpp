@@ -217,6 +217,22 @@ nlohmann::json read_report(const fs::path& folder) {
   return nlohmann::json::parse(in);
 }
 
+// Runs `elastic paste ARGS --out DIR/run/out`, checks it succeeded, moves the output folder to
+// DIR/elsewhere/copy (deleting the original) and returns the moved folder; the report is read
+// from there and every file it lists must exist there.
+fs::path paste_and_move(const std::string& args, const fs::path& dir, nlohmann::json& report) {
+  const fs::path out = dir / "run" / "out";
+  const auto [code, err] = run_elastic("paste -q " + args + " --out '" + out.string() + "'", dir);
+  EXPECT_EQ(code, 0) << err;
+  if (code != 0) {
+    return {};
+  }
+  const fs::path moved = move_elsewhere(out, dir / "elsewhere" / "copy");
+  report = read_report(moved);
+  check_report_files(report, moved);
+  return moved;
+}
+
 /// The heatmap's colour scale in the report, and its PLY as assimp reads it.
 void check_heatmap(const nlohmann::json& report, const fs::path& moved) {
   ASSERT_TRUE(report.contains("heatmap")) << "no colour scale in the report";
@@ -235,19 +251,15 @@ TEST(AssimpOutputs, DemoPasteOntoTheVaseStandsAloneWithEveryFaceOnAMaterial) {
   const fs::path emblem = dir / "emblem.png";
   ASSERT_EQ(run_elastic("render --emblem '" + emblem.string() + "' --size 256 --quiet", dir).first,
             0);
-  const fs::path out = dir / "run" / "out";
   // scripts/demo's paste with 1,500 particles instead of 5,775 and fewer refined vertices.
-  const auto [code, err] = run_elastic(
-      "paste -q --source-image '" + emblem.string() + "' --source-region ellipse --target '" +
+  nlohmann::json report;
+  const fs::path moved = paste_and_move(
+      "--source-image '" + emblem.string() + "' --source-region ellipse --target '" +
           test::project_mesh("vase_quads.obj").string() +
           "' --target-region disk:0.55,0,0.45,0.45 --particles 1500 --baseline lscm --preview "
-          "--preview-size 160 --min-vertices 4000 --out '" +
-          out.string() + "'",
-      dir);
-  ASSERT_EQ(code, 0) << err;
-  const fs::path moved = move_elsewhere(out, dir / "elsewhere" / "copy");
-  const nlohmann::json report = read_report(moved);
-  check_report_files(report, moved);
+          "--preview-size 160 --min-vertices 4000",
+      dir, report);
+  ASSERT_FALSE(HasFailure());
 
   // The vase has no UVs and no material: outside faces are on the default material, region
   // faces on the decal, nothing else.
@@ -294,19 +306,15 @@ TEST(AssimpOutputs, TexturedSpotKeepsItsTextureInEveryOutputAfterTheFolderMoves)
   const fs::path emblem = dir / "emblem.png";
   ASSERT_EQ(run_elastic("render --emblem '" + emblem.string() + "' --size 128 --quiet", dir).first,
             0);
-  const fs::path out = dir / "run" / "out";
   // A disk on spot's flank, baked into its texture and raised by the emblem's luminance.
-  const auto [code, err] =
-      run_elastic("paste -q --source-image '" + emblem.string() +
-                      "' --source-region ellipse --target '" + spot.string() +
-                      "' --target-region disk:0.33,0.07,0.24,0.15 --particles 400 --resolution 2 "
-                      "--min-vertices 3000 --bake --height luminance --height-scale 0.01 --out '" +
-                      out.string() + "'",
-                  dir);
-  ASSERT_EQ(code, 0) << err;
-  const fs::path moved = move_elsewhere(out, dir / "elsewhere" / "copy");
-  const nlohmann::json report = read_report(moved);
-  check_report_files(report, moved);
+  nlohmann::json report;
+  const fs::path moved = paste_and_move(
+      "--source-image '" + emblem.string() + "' --source-region ellipse --target '" +
+          spot.string() +
+          "' --target-region disk:0.33,0.07,0.24,0.15 --particles 400 --resolution 2 "
+          "--min-vertices 3000 --bake --height luminance --height-scale 0.01",
+      dir, report);
+  ASSERT_FALSE(HasFailure());
   const UvRange spot_uv = input_uv_range(spot);
   EXPECT_LT(spot_uv.lo, 0.0);  // spot's u reaches -0.052 (shared/meshes/README.md)
 
