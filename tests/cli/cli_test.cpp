@@ -89,11 +89,11 @@ TEST(Cli, BadRegionsAndValuesNameTheFlag) {
       "map --source " + mesh("plane_quads.obj") + " --target " + mesh("cap_quads.obj") + " ";
   // A disk centred far off the surface.
   expect_error(elastic(base + "--source-region disk:0,0,50,0.5", dir), 65, "--source-region");
-  // A region that is not a disk: a disk covering the whole closed... here, a malformed spec.
-  expect_error(elastic(base + "--source-region disk:0,0", dir), 65, "--source-region");
-  expect_error(elastic(base + "--source-anchor nan,0,0", dir), 65, "--source-anchor");
-  expect_error(elastic(base + "--particles 1000000000", dir), 65, "--particles");
-  expect_error(elastic(base + "--particles 3", dir), 65, "--particles");
+  // Malformed or out-of-range flag values are usage errors (64, docs/cli.md), naming the flag.
+  expect_error(elastic(base + "--source-region disk:0,0", dir), 64, "--source-region");
+  expect_error(elastic(base + "--source-anchor nan,0,0", dir), 64, "--source-anchor");
+  expect_error(elastic(base + "--particles 1000000000", dir), 64, "--particles");
+  expect_error(elastic(base + "--particles 3", dir), 64, "--particles");
   // Usage errors: an unknown flag, a missing required flag, a bad choice.
   EXPECT_EQ(elastic(base + "--no-such-flag", dir).code, 64);
   expect_error(elastic("map --source " + mesh("plane_quads.obj"), dir), 64, "--target");

@@ -5,13 +5,17 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cctype>
 #include <cstdio>
+#include <filesystem>
 #include <iostream>
 #include <memory>
 #include <string>
 
 #include "elastic/mesh/mesh_io.h"
+#include "elastic/core/error.h"
 #include "elastic/mesh/mesh_validation.h"
+#include "job_file.h"
 
 namespace elastic::cli {
 
@@ -121,6 +125,29 @@ void end_progress_line() {
 void print_warnings(const std::vector<std::string>& warnings, bool quiet) {
   if (quiet) return;
   for (const std::string& w : warnings) std::cerr << "elastic: warning: " << w << '\n';
+}
+
+RegionSpec parse_region_flag(const std::string& text, const std::string& flag) {
+  try {
+    return parse_region_spec(text, flag);
+  } catch (const InvalidInputError& e) {
+    if (e.input() == flag) throw UsageError(e.what());
+    throw;
+  }
+}
+
+void require_extension(const std::string& path, const std::vector<std::string>& extensions,
+                       const std::string& flag) {
+  std::string extension = std::filesystem::path(path).extension().string();
+  std::transform(extension.begin(), extension.end(), extension.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  std::string allowed;
+  for (const std::string& e : extensions) {
+    if (extension == e) return;
+    allowed += (allowed.empty() ? "" : " or ") + e;
+  }
+  throw UsageError(flag + " " + path + ": this output is written as " + allowed +
+                   " only; name the file with that extension");
 }
 
 }  // namespace elastic::cli

@@ -9,6 +9,7 @@
 #include "elastic/core/progress.h"
 #include "elastic/mesh/polygon_mesh.h"
 #include "elastic/projection/closest_point.h"
+#include "elastic/regions/region_spec.h"
 #include "elastic/surface/limit_surface.h"
 
 namespace elastic::cli {
@@ -40,5 +41,15 @@ void end_progress_line();
 
 /// Prints warnings to stderr ("elastic: warning: ...") unless quiet.
 void print_warnings(const std::vector<std::string>& warnings, bool quiet);
+
+/// Parses a region flag's spec (parse_region_spec). A malformed spec is a usage error (exit 64)
+/// naming `flag`; a `points:`/`uv:` file that is missing or malformed stays an IoError /
+/// InvalidInputError naming the file (exit 66 / 65).
+RegionSpec parse_region_flag(const std::string& text, const std::string& flag);
+
+/// Output formats come from the file extension: \throws UsageError naming `flag` and the path when
+/// `path`'s extension (case-insensitive) is not one of `extensions` (e.g. {".png"}).
+void require_extension(const std::string& path, const std::vector<std::string>& extensions,
+                       const std::string& flag);
 
 }  // namespace elastic::cli

@@ -294,7 +294,7 @@ std::string results_markdown(const nlohmann::json& report) {
 }
 
 int run_bench(const BenchArgs& args, const CLI::App& sub) {
-  if (args.runs < 1) throw InvalidInputError("--runs", "must be at least 1");
+  if (args.runs < 1) throw UsageError("--runs: must be at least 1");
   const nlohmann::json cases_file = read_cases_file(args.cases);
   nlohmann::json report;
   report["job"] = job_of(sub);

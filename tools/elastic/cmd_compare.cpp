@@ -30,7 +30,12 @@ std::vector<BaselineKind> parse_baselines(const std::string& text) {
   std::istringstream in(text);
   std::string item;
   while (std::getline(in, item, ',')) {
-    if (!item.empty()) out.push_back(parse_baseline_kind(item, "--baselines"));
+    if (item.empty()) continue;
+    try {
+      out.push_back(parse_baseline_kind(item, "--baselines"));
+    } catch (const InvalidInputError& e) {
+      throw UsageError(e.what());  // a malformed flag value: exit 64 (docs/cli.md)
+    }
   }
   return out;
 }
@@ -39,7 +44,11 @@ int run_compare(const CompareArgs& args, const CLI::App& sub) {
   CompareOptions options;
   options.baselines = parse_baselines(args.baselines);
   options.heatmap_dir = args.heatmap_dir;
-  options.heatmap.metric = parse_triangle_metric(args.heatmap_metric, "--heatmap-metric");
+  try {
+    options.heatmap.metric = parse_triangle_metric(args.heatmap_metric, "--heatmap-metric");
+  } catch (const InvalidInputError& e) {
+    throw UsageError(e.what());
+  }
   options.heatmap.percentile = args.heatmap_percentile;
 
   const std::unique_ptr<MapSession> session =
@@ -47,7 +56,7 @@ int run_compare(const CompareArgs& args, const CLI::App& sub) {
   end_progress_line();
   const std::vector<MethodMeasurement> methods = compare_methods(*session, options);
 
-  const nlohmann::json job = job_of(sub);
+  const nlohmann::json job = recorded_job(args.job, job_of(sub));
   const MapVerdict verdict = judge_map(args.job, *session);
   nlohmann::json report = {{"job", job},
                            {"map", map_report(args.job, *session, job)},

@@ -8,12 +8,14 @@
 #include <iostream>
 #include <nlohmann/json.hpp>
 #include <numbers>
+#include <sstream>
 
 #include "command.h"
 #include "elastic/core/atomic_file.h"
 #include "elastic/mesh/mesh_io.h"
 #include "elastic/mesh/mesh_validation.h"
 #include "elastic/surface/limit_surface.h"
+#include "elastic/render/up_axis.h"
 #include "elastic/surface/limit_tessellation.h"
 
 namespace elastic::cli {
@@ -25,6 +27,7 @@ struct InfoArgs {
   int resolution = 8;
   std::string json;
   bool repair = true;
+  bool quiet = false;
 };
 
 struct Stats {
@@ -96,6 +99,11 @@ int run_info(const InfoArgs& args) {
     hi = hi.cwiseMax(p);
   }
 
+  // Which way is up (render/up_axis.h: the side the model stands on), from the control mesh.
+  const UpAxisGuess up = guess_up_axis(mesh.positions);
+  Eigen::AlignedBox3d control_box;
+  for (const Eigen::Vector3d& p : mesh.positions) control_box.extend(p);
+
   const char* scheme = surface.scheme() == SubdivisionScheme::Loop ? "loop" : "catmull-clark";
   nlohmann::json report = {
       {"mesh", args.mesh},
@@ -110,6 +118,9 @@ int run_info(const InfoArgs& args) {
       {"quads_only", mesh.is_quad_mesh()},
       {"texcoords", mesh.has_texcoords()},
       {"findings_before_repair", before.describe()},
+      {"bbox_min", {control_box.min().x(), control_box.min().y(), control_box.min().z()}},
+      {"bbox_max", {control_box.max().x(), control_box.max().y(), control_box.max().z()}},
+      {"up_axis", {{"axis", up.name()}, {"reason", up.reason}, {"footprints", up.footprints}}},
       {"warnings", warnings},
       {"limit_surface",
        {{"scheme", scheme},
@@ -141,7 +152,20 @@ int run_info(const InfoArgs& args) {
             << "  " << v.num_vertices << " vertices, " << v.num_faces << " faces, " << v.num_edges
             << " edges, " << v.num_boundary_loops << " boundary loops, " << v.num_components
             << " component(s), chi = " << v.euler_characteristic << ", genus " << v.genus << '\n';
-  for (const std::string& w : warnings) std::cout << "  warning: " << w << '\n';
+  if (!args.quiet) {
+    for (const std::string& w : warnings) std::cout << "  warning: " << w << '\n';
+  }
+  const auto xyz = [](const Eigen::Vector3d& p) {
+    std::ostringstream text;
+    text << std::setprecision(6) << p.x() << ", " << p.y() << ", " << p.z();
+    return text.str();
+  };
+  const Eigen::Vector3d size = control_box.sizes();
+  std::cout << "  bounding box: min (" << xyz(control_box.min()) << "), max ("
+            << xyz(control_box.max()) << "), size " << xyz(size) << ", centre ("
+            << xyz(control_box.center()) << ")\n"
+            << "  up axis (guessed): " << up.name() << ", " << up.reason
+            << "; previews take --up to overrule it\n";
   std::cout << "limit surface: " << scheme << ", " << surface.num_faces() << " ptex faces, area "
             << std::setprecision(6) << total_area << ", curvature over " << n
             << " tessellation vertices:\n";
@@ -168,13 +192,19 @@ ELASTIC_COMMAND(
       sub.add_option("mesh", args->mesh, "Mesh file (OBJ, OFF, PLY, STL)")->required();
       sub.add_option("--scheme", args->scheme, "Subdivision scheme")
           ->check(CLI::IsMember({"auto", "loop", "catmull-clark"}));
-      sub.add_option("--resolution", args->resolution, "Tessellation segments per ptex edge")
+      // --resolution: the name before 0.2, kept as an alias for one release (docs/cli.md).
+      sub.add_option("--tessellation,--resolution", args->resolution,
+                     "Limit-surface tessellation for the curvature statistics: segments per ptex "
+                     "edge (old name --resolution)")
           ->check(CLI::Range(1, 256));
       sub.add_option("--json", args->json, "Also write the statistics as JSON to this file");
       sub.add_flag("!--no-repair", args->repair, "Fail on repairable defects instead of repairing");
+      sub.add_flag("-q,--quiet", args->quiet, "No warnings: only results");
       sub.footer(
           "Example:\n  elastic info meshes/torus_quads.obj --json torus.json\n"
-          "prints vertex/face counts, validation findings, and the limit surface's principal,\n"
-          "mean and Gaussian curvature statistics with a Gauss-Bonnet check on closed surfaces.");
+          "prints vertex/face counts, validation findings, the bounding box and the guessed up\n"
+          "axis (the side the model stands on: the largest flat footprint at an end of the box),\n"
+          "and the limit surface's principal, mean and Gaussian curvature statistics with a\n"
+          "Gauss-Bonnet check on closed surfaces.");
       return [args] { return elastic::cli::run_info(*args); };
     });

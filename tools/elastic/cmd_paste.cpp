@@ -25,6 +25,7 @@
 #include "elastic/transfer/tangent_frames.h"
 #include "job_file.h"
 #include "map_job.h"
+#include "aim.h"
 #include "paste_preview.h"
 #include "verdict.h"
 
@@ -39,7 +40,7 @@ struct PasteArgs {
   int texture_resolution = 0;     // --texture-resolution N (0: off)
   long min_vertices = 100'000;    // --min-vertices
   double max_edge = 0.0;          // --max-edge L
-  int resolution = 8;             // --resolution N (target tessellation)
+  int resolution = 8;             // --target-tessellation N (old name --resolution)
   int max_levels = 8;             // --max-levels
   long max_vertices = 2'000'000;  // --max-vertices
   bool bake = false;              // --bake
@@ -54,6 +55,7 @@ struct PasteArgs {
   double detail_scale = 1.0;      // --detail-scale
   bool preview = false;           // --preview
   int preview_size = 800;         // --preview-size N
+  std::string up = "auto";        // --up: the previews' up axis
   long frames = 0;                // --frames K (every K-th relaxation iteration)
   std::string baseline = "none";  // --baseline lscm|arap|dcm|none
 };
@@ -293,6 +295,7 @@ int run_paste(const PasteArgs& a, const CLI::App& sub) {
                             "has no colour to bake (no texture, no vertex colours)");
   }
 
+  std::vector<Eigen::Vector3d> displaced;  // with --height: the displaced painted positions
   if (!a.height.empty()) {
     // One height per region vertex: from a height image indexed by the source's texture
     // coordinates, or from the colour source's luminance.
@@ -336,6 +339,7 @@ int run_paste(const PasteArgs& a, const CLI::App& sub) {
     }
     // The target's own UVs and materials (its texture copied in), on the displaced positions.
     folder.write_obj("displaced.obj", make_target_mesh(painted, positions));
+    displaced = std::move(positions);
     paste["max_displacement"] = moved.max_displacement;
   }
 
@@ -396,17 +400,30 @@ int run_paste(const PasteArgs& a, const CLI::App& sub) {
       surface.add_face({c[0], c[1], c[2]});
       if (!painted.triangle_inside[static_cast<size_t>(t)]) outside.add_face({c[0], c[1], c[2]});
     }
-    const PreviewWriter preview(
-        session->target_region, std::move(surface), std::move(outside),
-        {.width = a.preview_size, .height = a.preview_size, .threads = a.job.threads});
+    const PreviewWriter preview(session->target_region, std::move(surface), std::move(outside),
+                                {.width = a.preview_size,
+                                 .height = a.preview_size,
+                                 .threads = a.job.threads,
+                                 .up = resolve_up(a.up, target.control_mesh())});
     const ParticleGrid& grid = result.sampling.grid;
     if (a.preview) {
-      const PolygonMesh shown =
+      PolygonMesh shown =
           colors && colors->kind() == ColorSourceKind::Texture
               ? make_decal_mesh(painted, *colors, {.texture_path = dir / "painted_decal.png"})
           : colors ? make_colored_mesh(painted, *colors)
                    : PolygonMesh();
+      // A height paste is shown displaced: the relief appears as shading, in preview.png under
+      // the colours and in preview_height.png alone (plain grey).
+      if (!displaced.empty() && shown.positions.size() == displaced.size()) {
+        shown.positions = displaced;
+      }
       if (shown.num_faces() > 0) files.push_back(preview.write_feature(dir / "preview.png", shown));
+      if (!displaced.empty()) {
+        PolygonMesh relief;
+        relief.positions = displaced;
+        for (const Eigen::Vector3i& c : painted.triangles) relief.add_face({c[0], c[1], c[2]});
+        files.push_back(preview.write_feature(dir / "preview_height.png", relief));
+      }
       files.push_back(preview.write_grids(dir / "preview_grid.png", grid,
                                           {&result.naive.positions, &result.relaxation.positions},
                                           {"naive map", "ElasticPaint"}));
@@ -473,8 +490,10 @@ ELASTIC_COMMAND(
       sub.add_option("--texture-resolution", a->texture_resolution,
                      "Refine the region to about one source texel of an N x N texture (0: off)");
       sub.add_option("--max-edge", a->max_edge, "Refine the region to edges at most this long");
-      sub.add_option("--resolution", a->resolution,
-                     "Target tessellation: segments per control edge")
+      // --resolution: the name before 0.2, kept as an alias for one release (docs/cli.md).
+      sub.add_option("--target-tessellation,--resolution", a->resolution,
+                     "Tessellation of the painted target outside the region: segments per "
+                     "control edge (old name --resolution)")
           ->check(CLI::Range(1, 1024));
       sub.add_option("--max-levels", a->max_levels, "Most refinement levels")
           ->check(CLI::Range(0, 12));
@@ -498,6 +517,9 @@ ELASTIC_COMMAND(
                    "and preview_heatmap.png (distortion, beside --baseline)");
       sub.add_option("--preview-size", a->preview_size, "Preview pictures are N x N pixels")
           ->check(CLI::Range(64, 4096));
+      sub.add_option("--up", a->up,
+                     "Up axis of the previews: auto (guessed from the target, as `elastic info`), "
+                     "x, y, z, -x, -y, -z or X,Y,Z");
       sub.add_option("--frames", a->frames,
                      "Render every K-th relaxation iteration to frames/ with a contact sheet")
           ->check(CLI::Range(0L, 1000000L));
@@ -508,7 +530,21 @@ ELASTIC_COMMAND(
           "Example:\n  elastic paste --source-image logo.png --target meshes/cap_quads.obj "
           "--target-region disk:0,0,1,0.5 \\\n      --particles 2000 --out pasted/\n"
           "writes pasted/painted.obj (+ .mtl, painted_decal.png), pasted/colors.ply, "
-          "pasted/heatmap.ply and "
-          "pasted/report.json.");
+          "pasted/heatmap.ply and pasted/report.json.\n"
+          "\n"
+          "Orientation: the feature's turn on the target is set by the boundary correspondence,\n"
+          "which starts at an anchor on each region's boundary: the source anchor lands on the\n"
+          "target anchor and the boundaries run counter-clockwise (seen from the normals) from\n"
+          "there. Without anchors the turn is chosen for the least distortion (--boundary-offset\n"
+          "auto), so it may not be upright. To fix it, give both anchors and --boundary-offset\n"
+          "anchor; each anchor is the boundary point nearest X,Y,Z. E.g. to put the top edge\n"
+          "of an image (on the plane z = 0, --image-width wide and centred at the origin: the\n"
+          "middle of its top side is 0,1,0 for a square image of width 2) towards the top of\n"
+          "a y-up target:\n"
+          "  elastic paste --source-image logo.png --source-anchor 0,1,0 \\\n"
+          "      --target ../shared/meshes/spot.obj --target-region disk:0.0197,0.452,0.741,0.25 "
+          "\\\n"
+          "      --target-anchor 0.0197,0.75,0.741 --boundary-offset anchor --out pasted/ --preview\n"
+          "`elastic locate` and `elastic region --preview` find the points (docs/cli.md, aiming).");
       return [a, &sub] { return elastic::cli::run_paste(*a, sub); };
     });

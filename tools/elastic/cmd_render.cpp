@@ -16,6 +16,7 @@
 #include "elastic/render/camera.h"
 #include "elastic/render/render.h"
 #include "job_file.h"
+#include "aim.h"
 #include "map_job.h"
 
 namespace elastic::cli {
@@ -30,8 +31,8 @@ struct RenderArgs {
   double azimuth = 0.0;
   double elevation = 0.0;
   bool angles = false;  ///< --azimuth or --elevation given
-  std::string up = "0,0,1";
-  double fov = 35.0;
+  std::string up = "auto";
+  double fov = kFramingFov;
   std::string wireframe;
   bool heatmap = false;
   bool edges = false;
@@ -70,6 +71,7 @@ int write_emblem(const RenderArgs& args) {
       args.size.empty() ? Eigen::Vector2i(512, 512) : parse_size(args.size);
   if (size.x() != size.y()) throw UsageError("--size " + args.size + ": the emblem is square");
   if (size.x() < 8 || size.x() > 8192) throw UsageError("--size: the emblem is 8..8192 pixels");
+  require_extension(args.emblem, {".png"}, "--emblem");
   write_png(args.emblem, make_emblem(size.x()));  // transparent outside the ring
   if (!args.quiet) std::cout << args.emblem << ": emblem " << size.x() << " x " << size.y() << '\n';
   return kOk;
@@ -95,6 +97,7 @@ int run_render(const RenderArgs& args) {
   if (!args.emblem.empty()) return write_emblem(args);
   if (args.meshes.empty()) throw UsageError("render: give at least one MESH (or --emblem OUT.png)");
   require_flag(args.out, "--out");
+  require_extension(args.out, {".png"}, "--out");
   const Eigen::Vector2i size =
       args.size.empty() ? Eigen::Vector2i(800, 600) : parse_size(args.size);
 
@@ -121,11 +124,11 @@ int run_render(const RenderArgs& args) {
 
   // The view: --view, turned by the angles if given; else the angles; else the first mesh's
   // vector area when it mostly faces one way (an open region), else an oblique default.
-  const Eigen::Vector3d up = parse_point(args.up, "--up");
+  const Eigen::Vector3d up = resolve_up(args.up, scene.objects.front().mesh);
   Eigen::Vector3d view;
   if (!args.view.empty()) {
     view = parse_point(args.view, "--view");
-    if (!(view.norm() > 0.0)) throw InvalidInputError("--view", "the direction is zero");
+    if (!(view.norm() > 0.0)) throw UsageError("--view: the direction is zero");
     if (args.angles) view = orbit_view(view, args.azimuth, args.elevation, up);
   } else if (args.angles) {
     view = view_from_angles(args.azimuth, args.elevation, up);
@@ -147,7 +150,9 @@ int run_render(const RenderArgs& args) {
   for (const SceneObject& object : scene.objects) {
     points.insert(points.end(), object.mesh.positions.begin(), object.mesh.positions.end());
   }
-  const Camera camera = frame_points(points, view, args.fov, size.x(), size.y(), 0.9, up);
+  // Framed at the default angle, then zoomed: --fov below 35 magnifies, above shows more.
+  Camera camera = frame_points(points, view, kFramingFov, size.x(), size.y(), 0.9, up);
+  camera.fov_deg = args.fov;
 
   RenderOptions options;
   options.samples_per_pixel = args.samples;
@@ -173,7 +178,7 @@ ELASTIC_COMMAND(
       auto args = std::make_shared<RenderArgs>();
       sub.add_option("meshes", args->meshes,
                      "Mesh files (OBJ with MTL textures, PLY with vertex/face colours, OFF, STL)");
-      sub.add_option("--out", args->out, "Output PNG");
+      sub.add_option("--out", args->out, "Output PNG (.png; other extensions are refused)");
       sub.add_option("--emblem", args->emblem,
                      "Write the built-in emblem to this PNG instead (no meshes)");
       sub.add_option("--size", args->size,
@@ -185,8 +190,13 @@ ELASTIC_COMMAND(
                                      "Degrees about --up (turns --view when given)");
       auto* elevation = sub.add_option("--elevation", args->elevation,
                                        "Degrees above the horizon (raises --view when given)");
-      sub.add_option("--up", args->up, "Up axis X,Y,Z")->capture_default_str();
-      sub.add_option("--fov", args->fov, "Vertical field of view in degrees")
+      sub.add_option("--up", args->up,
+                     "Up axis: auto (guessed from the first mesh, as `elastic info`), x, y, z, -x, "
+                     "-y, -z or X,Y,Z")
+          ->capture_default_str();
+      sub.add_option("--fov", args->fov,
+                     "Vertical field of view in degrees: the camera is placed for 35, so a "
+                     "smaller angle zooms in and a larger one out")
           ->check(CLI::Range(1.0, 170.0))
           ->capture_default_str();
       sub.add_option("--wireframe", args->wireframe,
@@ -210,7 +220,7 @@ ELASTIC_COMMAND(
                      "Skip textures with more pixels (width x height), checked before decoding")
           ->check(CLI::PositiveNumber)
           ->capture_default_str();
-      sub.add_flag("--quiet", args->quiet, "Print nothing but errors");
+      sub.add_flag("-q,--quiet", args->quiet, "Print nothing but errors");
       sub.footer(
           "Examples:\n"
           "  elastic shapes --out meshes --only cap\n"

@@ -12,6 +12,7 @@
 #include "elastic/regions/region_spec.h"
 #include "elastic/sampling/sample_region.h"
 #include "job_file.h"
+#include "map_job.h"
 
 namespace elastic::cli {
 namespace {
@@ -35,18 +36,18 @@ struct SampleArgs {
 };
 
 int run_sample(const SampleArgs& args, const CLI::App& sub) {
-  require_flag(args.mesh, "--mesh");
-  require_flag(args.region, "--region");
+  require_flag(args.mesh, "--source");
+  require_flag(args.region, "--source-region");
   LoadedSurface loaded = load_surface(args.mesh, args.scheme);
   print_warnings(loaded.warnings, args.quiet);
   RegionOptions region_options;
-  region_options.name = "--region";
-  const Region region =
-      make_region(*loaded.projector, parse_region_spec(args.region, "--region"), region_options);
+  region_options.name = "--source-region";
+  const Region region = make_region(
+      *loaded.projector, parse_region_flag(args.region, "--source-region"), region_options);
 
   SampleRegionOptions options;
   options.layout.particles = args.particles;
-  options.layout.name = "--region";
+  options.layout.name = "--source-region";
   options.layout.flattening =
       args.flattening == "disk" ? FlatteningMethod::Disk : FlatteningMethod::Conformal;
   options.adaptive = args.adaptive;
@@ -66,23 +67,27 @@ int run_sample(const SampleArgs& args, const CLI::App& sub) {
   const SamplingStatistics& st = sampled.statistics;
   const nlohmann::json report = {
       {"job", job_of(sub)},
-      {"mesh", args.mesh},
-      {"region", args.region},
+      {"source", args.mesh},
+      {"source_region", args.region},
       {"requested_particles", args.particles},
       {"particles", st.particles},
       {"interior_particles", st.interior_particles},
       {"boundary_particles", st.boundary_particles},
-      {"normal_springs", st.normal_springs},
-      {"angular_springs", st.angular_springs},
+      // The spring and sampling keys are named as in the map report (docs/file-formats.md).
+      {"springs", st.normal_springs + st.angular_springs},
+      {"springs_normal", st.normal_springs},
+      {"springs_angular", st.angular_springs},
       {"quads", st.quads},
       {"triangles", st.triangles},
       {"count_error", sampled.layout.count_error},
       {"lattice_spacing", sampled.layout.spacing},
       {"flattening", sampled.layout.flattening == FlatteningMethod::Disk ? "disk" : "conformal"},
       {"region_area", region.area()},
-      {"spacing",
-       {{"min", st.spacing_min}, {"median", st.spacing_median}, {"max", st.spacing_max}}},
-      {"density_ratio_high_low_curvature", st.density_ratio},
+      {"sampling",
+       {{"spacing_min", st.spacing_min},
+        {"spacing_median", st.spacing_median},
+        {"spacing_max", st.spacing_max},
+        {"density_ratio", st.density_ratio}}},
       {"min_corner_sine", st.min_corner_sine},
       {"inverted_faces", st.inverted_faces},
       {"adaptive",
@@ -120,11 +125,14 @@ int run_sample(const SampleArgs& args, const CLI::App& sub) {
 
 ELASTIC_COMMAND("sample", "Sample a source region with the particle grid", [](CLI::App& sub) {
   auto args = std::make_shared<elastic::cli::SampleArgs>();
-  sub.add_option("--mesh", args->mesh, "Source mesh file (OBJ, OFF, PLY, STL) (required)");
-  sub.add_option("--region", args->region,
-                 "Region (required): disk:X,Y,Z,R | points:FILE | boundary | uv:FILE");
-  sub.add_option("--particles", args->particles, "Number of particles (within 5%)")
-      ->check(CLI::Range(16L, 5'000'000L));
+  // --mesh and --region: the names before 0.2, kept as aliases for one release (docs/cli.md).
+  sub.add_option("--source,--mesh", args->mesh,
+                 "Source mesh file (OBJ, OFF, PLY, STL) (required; old name --mesh)");
+  sub.add_option("--source-region,--region", args->region,
+                 "Source region (required; old name --region): disk:X,Y,Z,R | points:FILE | "
+                 "boundary | uv:FILE");
+  sub.add_option("--particles", args->particles, "Number of particles (within 5%), 16..5000000")
+      ->check(CLI::Range(elastic::cli::kMinParticles, elastic::cli::kMaxParticles));
   sub.add_option("--seed", args->seed, "Seed of the initial jitter (with --jitter)");
   sub.add_option("--jitter", args->jitter, "Random initial displacement, fraction of the spacing")
       ->check(CLI::Range(0.0, 0.5));
@@ -147,7 +155,7 @@ ELASTIC_COMMAND("sample", "Sample a source region with the particle grid", [](CL
   sub.add_option("--report", args->report, "Write the statistics as JSON");
   sub.add_flag("-q,--quiet", args->quiet, "No progress line or warnings");
   sub.footer(
-      "Example:\n  elastic sample --mesh cap.obj --region disk:0,0,1,0.5 --particles 5000 "
+      "Example:\n  elastic sample --source cap.obj --source-region disk:0,0,1,0.5 --particles 5000 "
       "--out grid.obj --report grid.json");
   return [args, &sub] { return elastic::cli::run_sample(*args, sub); };
 });

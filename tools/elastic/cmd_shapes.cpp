@@ -23,6 +23,7 @@ struct ShapesArgs {
   std::string faces = "both";
   std::string format = "obj";
   std::string only;  ///< comma-separated names, empty for all
+  bool quiet = false;
 };
 
 std::vector<std::string> split_names(const std::string& list) {
@@ -81,7 +82,7 @@ int run_shapes(const ShapesArgs& args) {
         return kCantCreate;
       }
       const MeshValidation check = validate_mesh(mesh);
-      std::cout << path.string() << ": " << name << ", V " << mesh.num_vertices() << ", F "
+      if (!args.quiet) std::cout << path.string() << ": " << name << ", V " << mesh.num_vertices() << ", F "
                 << mesh.num_faces() << ", boundary loops " << check.num_boundary_loops << '\n';
     }
   }
@@ -97,8 +98,9 @@ ELASTIC_COMMAND(
       auto args = std::make_shared<ShapesArgs>();
       sub.add_option("--out", args->out, "Output directory (created if missing)")
           ->capture_default_str();
-      sub.add_option("--resolution", args->resolution,
-                     "Segments around the axis (per side for the plane)")
+      // --resolution: the name before 0.2, kept as an alias for one release (docs/cli.md).
+      sub.add_option("--segments,--resolution", args->resolution,
+                     "Segments around the axis (per side for the plane; old name --resolution)")
           ->check(CLI::Range(3, 4096))
           ->capture_default_str();
       sub.add_option("--faces", args->faces, "Triangles, quads or both")
@@ -109,8 +111,9 @@ ELASTIC_COMMAND(
           ->capture_default_str();
       sub.add_option("--only", args->only, "Comma-separated shape names (default: all)")
           ->check(check_names, "NAME,...");
+      sub.add_flag("-q,--quiet", args->quiet, "Print nothing but errors");
       sub.footer(
-          "Example:\n  elastic shapes --out meshes --resolution 32 --faces both\nwrites "
+          "Example:\n  elastic shapes --out meshes --segments 32 --faces both\nwrites "
           "<shape>_tris.obj and <shape>_quads.obj for every shape into meshes/.");
       return [args] { return run_shapes(*args); };
     });

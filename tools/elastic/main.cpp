@@ -7,6 +7,7 @@
 #include <exception>
 #include <iostream>
 #include <memory>
+#include <string>
 
 #include "command.h"
 #include "elastic/core/atomic_file.h"
@@ -39,6 +40,30 @@ void install_interrupt_handlers() {
   }
 }
 
+/// A message on one line: newlines (CLI11 puts some in) become "; ", trailing ones are dropped.
+std::string one_line(std::string text) {
+  while (!text.empty() && (text.back() == '\n' || text.back() == ' ')) text.pop_back();
+  for (size_t at = text.find('\n'); at != std::string::npos; at = text.find('\n', at)) {
+    text.replace(at, 1, "; ");
+  }
+  return text;
+}
+
+/// The subcommand named on the command line ("map", "bench table1"), empty when none was.
+std::string chosen_name(const CLI::App& app) {
+  std::string name;
+  for (const CLI::App* sub = &app; !sub->get_subcommands().empty();) {
+    sub = sub->get_subcommands().front();
+    name += (name.empty() ? "" : " ") + sub->get_name();
+  }
+  return name;
+}
+
+/// " (see elastic map --help)": where the grammar is, on the error's own line.
+std::string usage_hint(const std::string& subcommand) {
+  return " (see elastic " + (subcommand.empty() ? std::string() : subcommand + " ") + "--help)";
+}
+
 }  // namespace
 
 namespace elastic::cli {
@@ -65,22 +90,39 @@ int main(int argc, char** argv) {
     sub->option_defaults()->always_capture_default();
     auto runner = std::make_shared<std::function<int()>>();
     *runner = command.setup(*sub);
-    if (command.name != "version") {
-      add_job_option(*sub);
-      // Nested subcommands (e.g. `bench table1`) take a job file too.
-      for (CLI::App* nested : sub->get_subcommands({})) add_job_option(*nested);
-    }
+    // Every subcommand takes a job file (`version` too: one grammar, docs/cli.md); nested
+    // subcommands (e.g. `bench table1`) as well.
+    add_job_option(*sub);
+    for (CLI::App* nested : sub->get_subcommands({})) add_job_option(*nested);
     sub->callback([runner, sub, &run, &chosen] {
       run = *runner;
       chosen = sub;
     });
   }
 
+  // A first word that is neither a flag nor a subcommand: name it (CLI11 would only say that a
+  // subcommand is required).
+  if (argc > 1 && argv[1][0] != '-') {
+    bool known = false;
+    for (const Command& command : command_registry()) known = known || command.name == argv[1];
+    if (!known) {
+      std::cerr << "elastic: unknown subcommand '" << argv[1] << "'" << usage_hint("") << '\n';
+      return kUsage;
+    }
+  }
   try {
     app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e) == 0 ? kOk : kUsage;
+  } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e) == 0 ? kOk : kUsage;
+  } catch (const CLI::CallForVersion& e) {
+    return app.exit(e) == 0 ? kOk : kUsage;
   } catch (const CLI::ParseError& e) {
-    const int code = app.exit(e);
-    return code == 0 ? kOk : kUsage;
+    // CLI11's own messages name the flag ("--particles: Value 0 not in range ..."); they get the
+    // tool's prefix and stay on one line like every other error.
+    std::cerr << "elastic: " << one_line(e.what()) << usage_hint(chosen_name(app)) << '\n';
+    return kUsage;
   }
 
   try {
@@ -92,22 +134,22 @@ int main(int argc, char** argv) {
     }
     return run ? run() : kUsage;
   } catch (const UsageError& e) {
-    std::cerr << "elastic: " << e.what() << "\nRun with --help for more information.\n";
+    std::cerr << "elastic: " << one_line(e.what()) << usage_hint(chosen_name(app)) << '\n';
     return kUsage;
   } catch (const elastic::IoError& e) {
-    std::cerr << "elastic: " << e.what() << '\n';
+    std::cerr << "elastic: " << one_line(e.what()) << '\n';
     return e.direction() == elastic::IoError::Direction::Write ? kCantCreate : kNoInput;
   } catch (const elastic::InvalidInputError& e) {
-    std::cerr << "elastic: " << e.what() << '\n';
+    std::cerr << "elastic: " << one_line(e.what()) << '\n';
     return kBadInput;
   } catch (const elastic::NumericalError& e) {
-    std::cerr << "elastic: " << e.what() << '\n';
+    std::cerr << "elastic: " << one_line(e.what()) << '\n';
     return kNumerical;
   } catch (const std::bad_alloc&) {
     std::cerr << "elastic: out of memory\n";
     return kNumerical;
   } catch (const std::exception& e) {
-    std::cerr << "elastic: internal error: " << e.what() << '\n';
+    std::cerr << "elastic: internal error: " << one_line(e.what()) << '\n';
     return kNumerical;
   }
 }

@@ -51,10 +51,10 @@ Eigen::Vector3d parse_point(const std::string& text, const std::string& flag) {
   char c1 = 0, c2 = 0;
   std::istringstream in(text);
   if (!(in >> p.x() >> c1 >> p.y() >> c2 >> p.z()) || c1 != ',' || c2 != ',' || !p.allFinite()) {
-    throw InvalidInputError(flag, "expected X,Y,Z, got '" + text + "'");
+    throw UsageError(flag + ": expected X,Y,Z (finite numbers), got '" + text + "'");
   }
   std::string rest;
-  if (in >> rest) throw InvalidInputError(flag, "expected X,Y,Z, got '" + text + "'");
+  if (in >> rest) throw UsageError(flag + ": expected X,Y,Z (finite numbers), got '" + text + "'");
   return p;
 }
 
@@ -73,7 +73,8 @@ void add_map_flags(CLI::App& sub, MapJob& a) {
   sub.add_option("--target", a.target, "Target mesh file (required)");
   sub.add_option("--target-region", a.target_region, "Target region (same forms)");
   sub.add_option("--target-anchor", a.target_anchor, "X,Y,Z: start of the boundary correspondence");
-  sub.add_option("--particles", a.particles, "Number of particles (within 5%)");
+  sub.add_option("--particles", a.particles, "Number of particles (within 5%), 16..5000000")
+      ->check(CLI::Range(kMinParticles, kMaxParticles));
   sub.add_option("--solver", a.solver, "lbfgs (fast) or explicit (the paper's integrator)")
       ->check(CLI::IsMember({"lbfgs", "explicit"}));
   sub.add_option("--preconditioner", a.preconditioner,
@@ -137,10 +138,7 @@ std::unique_ptr<MapSession> run_map_job(const MapJob& job, const ProgressCallbac
                                         SurfaceCache* cache) {
   const auto start = std::chrono::steady_clock::now();
   require_flag(job.target, "--target");
-  if (job.particles < 16 || job.particles > 5'000'000) {
-    throw InvalidInputError("--particles",
-                            "must be between 16 and 5000000, got " + std::to_string(job.particles));
-  }
+  check_particles(job.particles);
   if (job.source.empty() == job.source_image.empty()) {
     throw UsageError("give exactly one of --source MESH and --source-image IMAGE");
   }
@@ -151,9 +149,9 @@ std::unique_ptr<MapSession> run_map_job(const MapJob& job, const ProgressCallbac
   if (!job.source_image.empty()) {
     if (job.source_region != "boundary" && job.source_region != "rectangle" &&
         job.source_region != "ellipse") {
-      throw InvalidInputError(
-          "--source-region", "with --source-image it is 'rectangle' (default) or 'ellipse', got '" +
-                                 job.source_region + "'");
+      throw UsageError("--source-region: with --source-image it is 'rectangle' (default) or "
+                       "'ellipse', got '" +
+                       job.source_region + "'");
     }
     s.image =
         make_image_plane(job.source_image,
@@ -183,10 +181,10 @@ std::unique_ptr<MapSession> run_map_job(const MapJob& job, const ProgressCallbac
   print_warnings(s.target.warnings, job.quiet);
 
   RegionSpec source_spec =
-      s.image ? s.image->region : parse_region_spec(job.source_region, "--source-region");
+      s.image ? s.image->region : parse_region_flag(job.source_region, "--source-region");
   if (!job.source_anchor.empty())
     source_spec.anchor = parse_point(job.source_anchor, "--source-anchor");
-  RegionSpec target_spec = parse_region_spec(job.target_region, "--target-region");
+  RegionSpec target_spec = parse_region_flag(job.target_region, "--target-region");
   if (!job.target_anchor.empty())
     target_spec.anchor = parse_point(job.target_anchor, "--target-anchor");
   s.source_region = make_region(*s.source.projector, source_spec, {.name = "--source-region"});
@@ -204,13 +202,32 @@ std::unique_ptr<MapSession> run_map_job(const MapJob& job, const ProgressCallbac
   return session;
 }
 
+void check_particles(long particles) {
+  if (particles < kMinParticles || particles > kMaxParticles) {
+    throw UsageError("--particles: must be between " + std::to_string(kMinParticles) + " and " +
+                     std::to_string(kMaxParticles) + ", got " + std::to_string(particles));
+  }
+}
+
+std::string effective_source_region(const MapJob& job) {
+  // An image source's region is its rectangle unless the ellipse is asked for; "boundary" (the
+  // flag's default for a mesh) means the rectangle there.
+  if (!job.source_image.empty() && job.source_region != "ellipse") return "rectangle";
+  return job.source_region;
+}
+
+nlohmann::json recorded_job(const MapJob& job, nlohmann::json job_json) {
+  if (job_json.contains("source-region")) job_json["source-region"] = effective_source_region(job);
+  return job_json;
+}
+
 nlohmann::json map_report(const MapJob& job, const MapSession& session,
                           const nlohmann::json& job_json) {
   const MapResult& r = session.result;
   const RelaxationResult& x = r.relaxation;
   const SamplingStatistics& s = r.sampling.statistics;
   return {
-      {"job", job_json},
+      {"job", recorded_job(job, job_json)},
       {"particles", s.particles},
       {"springs", s.normal_springs + s.angular_springs},
       {"springs_normal", s.normal_springs},
@@ -294,7 +311,8 @@ void print_map_summary(const MapJob& job, const MapSession& session) {
   std::cout << "particles " << s.particles << ", springs " << s.normal_springs + s.angular_springs
             << ", solver " << job.solver << ", " << x.iterations << " iterations, "
             << (x.converged ? "converged" : "NOT converged") << " (" << to_string(x.reason) << ")\n"
-            << "length energy " << x.length_energy << ", angle energy " << x.angular_energy
+            << "solver energy: length springs " << x.length_energy << ", angle springs "
+            << x.angular_energy
             << ", relative gradient " << x.relative_gradient << ", folds " << session.metrics.folds
             << ", worst sigma_min " << session.metrics.sigma_min << ", boundary residual "
             << x.boundary_residual << '\n'

@@ -115,7 +115,19 @@ MapMetrics measure_placement(const MapSession& session, const Eigen::Matrix3Xd& 
                              const std::vector<SurfacePoint>& points,
                              std::vector<char> outside = {});
 
-/// Parses "X,Y,Z" (finite numbers). \throws InvalidInputError naming `flag`.
+/// The range of --particles on every subcommand that samples (sample, map, paste, compare, bench).
+inline constexpr long kMinParticles = 16;
+inline constexpr long kMaxParticles = 5'000'000;
+/// \throws UsageError naming --particles outside [kMinParticles, kMaxParticles] (exit 64).
+void check_particles(long particles);
+
+/// The source region a job uses: its --source-region, except for an image source, whose region is
+/// "rectangle" unless "ellipse" is given. Reports record this one.
+std::string effective_source_region(const MapJob& job);
+/// `job_json` (job_of) with "source-region" as effective_source_region.
+nlohmann::json recorded_job(const MapJob& job, nlohmann::json job_json);
+
+/// Parses "X,Y,Z" (finite numbers). \throws UsageError naming `flag` (a malformed flag value).
 Eigen::Vector3d parse_point(const std::string& text, const std::string& flag);
 
 }  // namespace elastic::cli

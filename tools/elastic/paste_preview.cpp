@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <utility>
 
+#include "aim.h"
 #include "elastic/image/image.h"
 #include "elastic/metrics/heatmap.h"
 #include "elastic/render/compose.h"
@@ -14,8 +15,7 @@
 namespace elastic::cli {
 namespace {
 
-constexpr double kFieldOfView = 35.0;  // degrees: a mild perspective
-constexpr double kFill = 0.8;          // the region fills 80% of the picture
+constexpr double kFill = 0.6;  // the region fills 60% of the picture: its surroundings show
 
 RenderOptions render_options(const PreviewSettings& settings) {
   RenderOptions options;
@@ -41,26 +41,16 @@ SceneObject grid_object(const ParticleGrid& grid, const Eigen::Matrix3Xd& positi
 
 }  // namespace
 
-Camera region_camera(const Region& region, int width, int height) {
-  Eigen::Vector3d normal = Eigen::Vector3d::Zero();
-  for (const Eigen::Vector3i& t : region.triangles) {
-    const Eigen::Vector3d& a = region.positions[static_cast<size_t>(t[0])];
-    normal += (region.positions[static_cast<size_t>(t[1])] - a)
-                  .cross(region.positions[static_cast<size_t>(t[2])] - a);
-  }
-  if (normal.norm() == 0.0) normal = Eigen::Vector3d::UnitZ();
-  normal.normalize();
-  // A view straight along a vertical normal looks flat: tilt it towards the viewer a little.
-  Eigen::Vector3d view = normal;
-  if (std::abs(normal.z()) > 0.9) view = (normal + Eigen::Vector3d(0.0, -0.5, 0.0)).normalized();
-  return frame_points(region.positions, view, kFieldOfView, width, height, kFill);
+Camera region_camera(const Region& region, int width, int height, const Eigen::Vector3d& up) {
+  return aim_camera(region.positions, region_figures(region).normal, up, kFramingFov, width, height,
+                    kFill);
 }
 
 PreviewWriter::PreviewWriter(const Region& target_region, PolygonMesh target_surface,
                              PolygonMesh target_outside, const PreviewSettings& settings)
-    : camera_(region_camera(target_region, settings.width, settings.height)),
+    : camera_(region_camera(target_region, settings.width, settings.height, settings.up)),
       small_camera_(region_camera(target_region, std::max(64, settings.width / 2),
-                                  std::max(64, settings.height / 2))),
+                                  std::max(64, settings.height / 2), settings.up)),
       surface_(std::move(target_surface)),
       outside_(std::move(target_outside)),
       settings_(settings) {}

@@ -2,7 +2,8 @@
 // Pictures of a paste (`elastic paste --preview`): the target with the pasted feature, the particle
 // grid over the target (naive and relaxed, side by side: the paper's Figs. 6 and 9), distortion
 // heatmaps (ElasticPaint beside a baseline), and the relaxation as numbered frames with a contact
-// sheet. The camera frames the target region, seen along its mean normal.
+// sheet. The camera frames the target region with some of the model around it (aim.h), seen along
+// its mean normal raised towards the up axis, with the picture's up along that axis.
 
 #include <Eigen/Core>
 #include <filesystem>
@@ -22,11 +23,13 @@ struct PreviewSettings {
   int width = 800;   ///< pixels
   int height = 800;  ///< pixels
   int threads = 0;   ///< render threads (0: all); the pictures do not depend on it
+  Eigen::Vector3d up = Eigen::Vector3d::UnitZ();  ///< the model's up (--up, or guessed)
 };
 
-/// The camera for every picture of a paste: the region's vertices framed, seen along the region's
-/// mean normal (its vector area), from slightly above when the normal is near the vertical.
-Camera region_camera(const Region& region, int width, int height);
+/// The camera for every picture of a paste: aim_camera (aim.h) on the region's vertices, which
+/// fill 60% of the picture (the rest shows the model around them), seen along the region's mean
+/// normal raised towards `up`.
+Camera region_camera(const Region& region, int width, int height, const Eigen::Vector3d& up);
 
 class PreviewWriter {
  public:

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <fstream>
 #include <limits>
+#include <functional>
 #include <sstream>
 
 #include "elastic/core/error.h"
@@ -162,17 +163,25 @@ struct Context {
     return best;
   }
 
-  /// Projects a user point onto the surface; error when it is far from it.
-  MeshLocation project(const Eigen::Vector3d& x, const std::string& what) const {
+  /// Projects a user point onto the surface; error when it is far from it. The error names the
+  /// nearest surface point, and `suggest` (when given) turns that point into a ready spec, e.g.
+  /// "disk:X,Y,Z,R", so that the user can copy it.
+  MeshLocation project(const Eigen::Vector3d& x, const std::string& what,
+                       const std::function<std::string(const Eigen::Vector3d&)>& suggest =
+                           {}) const {
     if (!x.allFinite()) {
       throw InvalidInputError(options.name, what + " is not finite");
     }
     const ClosestPoint cp = projector.closest(x);
     if (cp.distance > options.max_point_distance * diagonal) {
       std::ostringstream msg;
+      msg.precision(6);
+      const Eigen::Vector3d& q = cp.position;
       msg << what << " (" << x.x() << ", " << x.y() << ", " << x.z()
           << ") is far from the surface (" << cp.distance << " away, more than "
-          << options.max_point_distance << " of the bounding-box diagonal)";
+          << options.max_point_distance << " of the bounding-box diagonal); the nearest surface "
+          << "point is (" << q.x() << ", " << q.y() << ", " << q.z() << ")";
+      if (suggest) msg << ": try " << suggest(q);
       throw InvalidInputError(options.name, msg.str());
     }
     return locate(cp.point);
@@ -226,7 +235,12 @@ Region disk_region(const Context& ctx, const RegionSpec& spec) {
     throw InvalidInputError(name,
                             "disk radius " + std::to_string(spec.radius) + " must be positive");
   }
-  const MeshLocation centre = ctx.project(spec.center, "disk centre");
+  const MeshLocation centre = ctx.project(spec.center, "disk centre", [&](const Eigen::Vector3d& q) {
+    std::ostringstream text;
+    text.precision(6);
+    text << "disk:" << q.x() << ',' << q.y() << ',' << q.z() << ',' << spec.radius;
+    return text.str();
+  });
   const regions_detail::HeatGeodesics heat(ctx.tess.positions, ctx.tess.triangles, name);
   const Eigen::VectorXd distance = heat.distance(centre);
   CutMesh cut = ctx.cut_mesh();
