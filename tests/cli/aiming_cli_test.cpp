@@ -29,9 +29,8 @@ std::string mesh(const std::string& name) {
 
 TEST(Aiming, InfoPrintsTheBoundingBoxAndTheUpAxisItGuesses) {
   const fs::path dir = test::scratch_dir("aim_info");
-  const CliRun plane = elastic("info " + mesh("plane_quads.obj") + " --json " +
-                                   (dir / "plane.json").string(),
-                               dir);
+  const CliRun plane = elastic(
+      "info " + mesh("plane_quads.obj") + " --report " + (dir / "plane.json").string(), dir);
   ASSERT_EQ(plane.code, 0) << plane.err;
   EXPECT_NE(plane.out.find("bounding box: min (-1, -1, 0), max (1, 1, 0)"), std::string::npos)
       << plane.out;
@@ -69,10 +68,10 @@ TEST(Aiming, LocateGivesTheClosestPointItsNormalAndAReadySpec) {
 
 TEST(Aiming, FarDiskCentreNamesTheNearestSurfacePointAndASpecThatWorks) {
   const fs::path dir = test::scratch_dir("aim_far");
-  const CliRun run = elastic("map --source " + mesh("plane_quads.obj") +
-                                 " --source-region disk:0.2,0.1,7,0.3 --target " +
-                                 mesh("cap_quads.obj"),
-                             dir);
+  const CliRun run =
+      elastic("map --source " + mesh("plane_quads.obj") +
+                  " --source-region disk:0.2,0.1,7,0.3 --target " + mesh("cap_quads.obj"),
+              dir);
   ASSERT_EQ(run.code, 65) << run.err;
   EXPECT_NE(run.err.find("nearest surface point is (0.2, 0.1, 0)"), std::string::npos) << run.err;
   const size_t at = run.err.find("try disk:");
@@ -93,7 +92,8 @@ double tinted_fraction(const Image& image) {
 TEST(Aiming, RegionReportsItsFiguresAndPreviewsItWithItsSurroundings) {
   const fs::path dir = test::scratch_dir("aim_region");
   const std::string plane = mesh("plane_quads.obj");
-  const CliRun run = elastic("region " + plane + " disk:0,0,0,0.5 --json --preview-size 200 "
+  const CliRun run = elastic("region " + plane +
+                                 " disk:0,0,0,0.5 --json --preview-size 200 "
                                  "--preview " +
                                  (dir / "wide.png").string(),
                              dir);
@@ -113,8 +113,9 @@ TEST(Aiming, RegionReportsItsFiguresAndPreviewsItWithItsSurroundings) {
   EXPECT_GT(wide_tint, 0.03);
   EXPECT_LT(wide_tint, 0.35);
   // --fov zooms: half the angle magnifies the region about (tan 17.5 / tan 8.75)^2 = 4 times.
-  ASSERT_EQ(elastic("region -q " + plane + " disk:0,0,0,0.5 --fov 17.5 --preview-size 200 "
-                                           "--preview " +
+  ASSERT_EQ(elastic("region -q " + plane +
+                        " disk:0,0,0,0.5 --fov 17.5 --preview-size 200 "
+                        "--preview " +
                         (dir / "zoom.png").string(),
                     dir)
                 .code,

@@ -67,9 +67,10 @@ std::vector<std::string> subcommands(const fs::path& dir) {
 TEST(Grammar, SampleNamesItsSourceLikeEveryOtherSubcommand) {
   const fs::path dir = test::scratch_dir("grammar_sample");
   const std::string rest = " --particles 100 -q --report ";
-  const CliRun now = elastic("sample --source " + mesh("plane_quads.obj") +
-                                 " --source-region disk:0,0,0,0.8" + rest + (dir / "a.json").string(),
-                             dir);
+  const CliRun now =
+      elastic("sample --source " + mesh("plane_quads.obj") + " --source-region disk:0,0,0,0.8" +
+                  rest + (dir / "a.json").string(),
+              dir);
   ASSERT_EQ(now.code, 0) << now.err;
   // The old names still work for one release, with the same result.
   const CliRun old = elastic("sample --mesh " + mesh("plane_quads.obj") +
@@ -101,9 +102,9 @@ TEST(Grammar, EverySubcommandTakesQuiet) {
   EXPECT_EQ(shapes.code, 0) << shapes.err;
   EXPECT_TRUE(shapes.out.empty()) << shapes.out;
   EXPECT_TRUE(fs::exists(dir / "shapes" / "plane_quads.obj"));
-  const CliRun render = elastic("render -q " + mesh("plane_quads.obj") + " --size 32 --out " +
-                                    (dir / "plane.png").string(),
-                                dir);
+  const CliRun render = elastic(
+      "render -q " + mesh("plane_quads.obj") + " --size 32 --out " + (dir / "plane.png").string(),
+      dir);
   EXPECT_EQ(render.code, 0) << render.err;
   EXPECT_TRUE(render.out.empty()) << render.out;
   EXPECT_EQ(elastic("info -q " + mesh("plane_quads.obj"), dir).code, 0);
@@ -121,12 +122,21 @@ TEST(Grammar, ResolutionsHaveOneNameEachAndTheOldOneStillWorks) {
   EXPECT_NE(paste.find("--target-tessellation"), std::string::npos) << paste;
   EXPECT_EQ(elastic("info --tessellation 2 " + mesh("plane_quads.obj"), dir).code, 0);
   EXPECT_EQ(elastic("info --resolution 2 " + mesh("plane_quads.obj"), dir).code, 0);
+  EXPECT_EQ(elastic("shapes -q --segments 8 --only plane --out " + (dir / "a").string(), dir).code,
+            0);
   EXPECT_EQ(
-      elastic("shapes -q --segments 8 --only plane --out " + (dir / "a").string(), dir).code, 0);
-  EXPECT_EQ(
-      elastic("shapes -q --resolution 8 --only plane --out " + (dir / "b").string(), dir).code,
-      0);
+      elastic("shapes -q --resolution 8 --only plane --out " + (dir / "b").string(), dir).code, 0);
   EXPECT_EQ(test::slurp(dir / "a" / "plane_quads.obj"), test::slurp(dir / "b" / "plane_quads.obj"));
+  // info's JSON file is a --report like every other; --json FILE stays for one release.
+  EXPECT_EQ(
+      elastic("info -q " + mesh("plane_quads.obj") + " --report " + (dir / "r.json").string(), dir)
+          .code,
+      0);
+  EXPECT_EQ(
+      elastic("info -q " + mesh("plane_quads.obj") + " --json " + (dir / "j.json").string(), dir)
+          .code,
+      0);
+  EXPECT_EQ(test::slurp(dir / "r.json"), test::slurp(dir / "j.json"));
   // A shape flag is not an info flag.
   EXPECT_EQ(elastic("info --segments 2 " + mesh("plane_quads.obj"), dir).code, 64);
 }
@@ -144,14 +154,13 @@ TEST(Grammar, ParticlesOutOfRangeIsTheSameUsageErrorEverywhere) {
         64, "--particles");
     expect_one_line_error(elastic("map" + source + p, dir), 64, "--particles");
     expect_one_line_error(elastic("compare" + source + p, dir), 64, "--particles");
-    expect_one_line_error(
-        elastic("paste" + source + p + " --out " + (dir / "out").string(), dir), 64,
-        "--particles");
+    expect_one_line_error(elastic("paste" + source + p + " --out " + (dir / "out").string(), dir),
+                          64, "--particles");
   }
   // In a job file too.
   std::ofstream(dir / "job.json") << R"({"command": "map", "particles": 0})";
-  expect_one_line_error(elastic("map" + source + " --job " + (dir / "job.json").string(), dir),
-                        64, "particles");
+  expect_one_line_error(elastic("map" + source + " --job " + (dir / "job.json").string(), dir), 64,
+                        "particles");
 }
 
 TEST(Grammar, ParseErrorsAreOneElasticLineNamingTheFlag) {
@@ -179,8 +188,8 @@ TEST(Grammar, OutputFormatsComeFromTheExtensionOrAreRefused) {
   EXPECT_FALSE(fs::exists(dir / "a.jpg"));
   expect_one_line_error(elastic("render --emblem " + (dir / "e.bmp").string(), dir), 64, "e.bmp");
   EXPECT_FALSE(fs::exists(dir / "e.bmp"));
-  expect_one_line_error(elastic("region " + mesh("plane_quads.obj") +
-                                    " disk:0,0,0,0.5 --preview " + (dir / "p.gif").string(),
+  expect_one_line_error(elastic("region " + mesh("plane_quads.obj") + " disk:0,0,0,0.5 --preview " +
+                                    (dir / "p.gif").string(),
                                 dir),
                         64, "p.gif");
   // Upper case is the same extension.
@@ -220,11 +229,11 @@ TEST(Grammar, ReportKeysAreNamedOneWayAndDocumented) {
             0);
   const nlohmann::json sample = nlohmann::json::parse(std::ifstream(dir / "sample.json"));
   const nlohmann::json map = nlohmann::json::parse(std::ifstream(dir / "map.json"));
-  const std::string formats = test::slurp(fs::path(ELASTIC_MESHES_DIR).parent_path() / "docs" /
-                                          "file-formats.md");
+  const std::string formats =
+      test::slurp(fs::path(ELASTIC_MESHES_DIR).parent_path() / "docs" / "file-formats.md");
   // The same quantity has the same key (and the same value: one grid, one seed) in both.
-  for (const char* key : {"particles", "boundary_particles", "springs", "springs_normal",
-                          "springs_angular"}) {
+  for (const char* key :
+       {"particles", "boundary_particles", "springs", "springs_normal", "springs_angular"}) {
     SCOPED_TRACE(key);
     ASSERT_TRUE(sample.contains(key)) << sample.dump();
     ASSERT_TRUE(map.contains(key));
@@ -246,13 +255,13 @@ TEST(Grammar, OneLengthEnergyPerStdoutAndImageSourcesRecordTheirRegion) {
   const std::string emblem = (dir / "emblem.png").string();
   ASSERT_EQ(elastic("render -q --emblem " + emblem + " --size 64", dir).code, 0);
   const fs::path out = dir / "out";
-  const CliRun run = elastic("paste --source-image " + emblem + " --target " +
-                                 mesh("cap_quads.obj") +
-                                 " --target-region disk:0,0,1,0.5 --particles 150 "
-                                 "--min-vertices 500 --preview --preview-size 64 "
-                                 "--height luminance --out " +
-                                 out.string(),
-                             dir);
+  const CliRun run =
+      elastic("paste --source-image " + emblem + " --target " + mesh("cap_quads.obj") +
+                  " --target-region disk:0,0,1,0.5 --particles 150 "
+                  "--min-vertices 500 --preview --preview-size 64 "
+                  "--height luminance --out " +
+                  out.string(),
+              dir);
   ASSERT_EQ(run.code, 0) << run.err;
   EXPECT_EQ(count_of(run.out, "length energy"), 1) << run.out;
   // The job names the region the run used: the image's rectangle, not the mesh default.
@@ -261,9 +270,9 @@ TEST(Grammar, OneLengthEnergyPerStdoutAndImageSourcesRecordTheirRegion) {
   // A height paste is previewed as shading of the displaced surface.
   EXPECT_TRUE(fs::exists(out / "preview_height.png"));
   // The report repeats the run.
-  const CliRun again = elastic("paste -q --job " + (out / "report.json").string() + " --out " +
-                                   (dir / "again").string(),
-                               dir);
+  const CliRun again = elastic(
+      "paste -q --job " + (out / "report.json").string() + " --out " + (dir / "again").string(),
+      dir);
   EXPECT_EQ(again.code, 0) << again.err;
 }
 
@@ -273,9 +282,8 @@ TEST(Grammar, ImageErrorsGiveAReason) {
   std::ofstream(dir / "text.png") << "not an image\n";
   for (const char* name : {"empty.png", "text.png"}) {
     SCOPED_TRACE(name);
-    const CliRun run = elastic("map --source-image " + (dir / name).string() + " --target " +
-                                   mesh("cap_quads.obj"),
-                               dir);
+    const CliRun run = elastic(
+        "map --source-image " + (dir / name).string() + " --target " + mesh("cap_quads.obj"), dir);
     expect_one_line_error(run, 65, name);
     EXPECT_EQ(run.err.find("()"), std::string::npos) << run.err;
   }

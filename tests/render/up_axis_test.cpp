@@ -55,8 +55,7 @@ TEST(UpAxis, FourLeggedShapeStandsOnItsLegsWhicheverAxisIsUp) {
       EXPECT_EQ(guess.sign, sign) << guess.reason;
       EXPECT_NEAR((guess.direction - up).norm(), 0.0, 1e-12);
       // The legs' square, 1.4 x 1.4 of the 2 x 2 cross-section.
-      EXPECT_NEAR(guess.footprints[static_cast<size_t>(2 * axis + (sign > 0 ? 0 : 1))], 0.49,
-                  1e-9);
+      EXPECT_NEAR(guess.footprints[static_cast<size_t>(2 * axis + (sign > 0 ? 0 : 1))], 0.49, 1e-9);
     }
   }
 }

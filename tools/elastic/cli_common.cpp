@@ -3,17 +3,17 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cctype>
 #include <chrono>
 #include <cmath>
-#include <cctype>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
 #include <memory>
 #include <string>
 
-#include "elastic/mesh/mesh_io.h"
 #include "elastic/core/error.h"
+#include "elastic/mesh/mesh_io.h"
 #include "elastic/mesh/mesh_validation.h"
 #include "job_file.h"
 

@@ -14,8 +14,8 @@
 #include "elastic/core/atomic_file.h"
 #include "elastic/mesh/mesh_io.h"
 #include "elastic/mesh/mesh_validation.h"
-#include "elastic/surface/limit_surface.h"
 #include "elastic/render/up_axis.h"
+#include "elastic/surface/limit_surface.h"
 #include "elastic/surface/limit_tessellation.h"
 
 namespace elastic::cli {
@@ -197,11 +197,14 @@ ELASTIC_COMMAND(
                      "Limit-surface tessellation for the curvature statistics: segments per ptex "
                      "edge (old name --resolution)")
           ->check(CLI::Range(1, 256));
-      sub.add_option("--json", args->json, "Also write the statistics as JSON to this file");
+      // --json FILE: the name before 0.2, kept as an alias for one release (docs/cli.md); --json
+      // on `locate` and `region` is a flag that prints JSON on stdout.
+      sub.add_option("--report,--json", args->json,
+                     "Also write the statistics as JSON to this file (old name --json)");
       sub.add_flag("!--no-repair", args->repair, "Fail on repairable defects instead of repairing");
       sub.add_flag("-q,--quiet", args->quiet, "No warnings: only results");
       sub.footer(
-          "Example:\n  elastic info meshes/torus_quads.obj --json torus.json\n"
+          "Example:\n  elastic info meshes/torus_quads.obj --report torus.json\n"
           "prints vertex/face counts, validation findings, the bounding box and the guessed up\n"
           "axis (the side the model stands on: the largest flat footprint at an end of the box),\n"
           "and the limit surface's principal, mean and Gaussian curvature statistics with a\n"

@@ -1,6 +1,7 @@
 // `elastic locate MESH X,Y,Z`: the closest point of the limit surface to a point, its normal and a
 // ready `disk:` spec, so that a region can be aimed without reading vertex coordinates by hand.
 #include <Eigen/Geometry>
+#include <cmath>
 #include <iomanip>
 #include <iostream>
 #include <memory>
@@ -24,9 +25,14 @@ struct LocateArgs {
   bool quiet = false;
 };
 
-std::string point_text(const Eigen::Vector3d& p) {
+/// "x,y,z" with 6 significant digits; coordinates below 1e-9 of `scale` (round-off of a zero)
+/// are written as 0.
+std::string point_text(const Eigen::Vector3d& p, double scale = 1.0) {
   std::ostringstream out;
-  out << std::setprecision(6) << p.x() << ',' << p.y() << ',' << p.z();
+  out << std::setprecision(6);
+  for (int k = 0; k < 3; ++k) {
+    out << (k > 0 ? "," : "") << (std::abs(p[k]) < 1e-9 * scale ? 0.0 : p[k]);
+  }
   return out.str();
 }
 
@@ -41,28 +47,29 @@ int run_locate(const LocateArgs& args) {
   const double radius = args.radius > 0.0 ? args.radius : 0.1 * box.diagonal().norm();
   std::ostringstream radius_text;
   radius_text << std::setprecision(4) << radius;
-  const std::string disk = "disk:" + point_text(cp.position) + "," + radius_text.str();
+  const double scale = box.diagonal().norm();
+  const std::string disk = "disk:" + point_text(cp.position, scale) + "," + radius_text.str();
 
   if (args.json) {
-    const nlohmann::json out = {
-        {"mesh", args.mesh},
-        {"query", {query.x(), query.y(), query.z()}},
-        {"point", {cp.position.x(), cp.position.y(), cp.position.z()}},
-        {"normal", {cp.normal.x(), cp.normal.y(), cp.normal.z()}},
-        {"distance", cp.distance},
-        {"on_boundary", cp.on_boundary},
-        {"ptex_face", cp.point.face},
-        {"ptex_uv", {cp.point.u, cp.point.v}},
-        {"radius", radius},
-        {"disk", disk}};
+    const nlohmann::json out = {{"mesh", args.mesh},
+                                {"query", {query.x(), query.y(), query.z()}},
+                                {"point", {cp.position.x(), cp.position.y(), cp.position.z()}},
+                                {"normal", {cp.normal.x(), cp.normal.y(), cp.normal.z()}},
+                                {"distance", cp.distance},
+                                {"on_boundary", cp.on_boundary},
+                                {"ptex_face", cp.point.face},
+                                {"ptex_uv", {cp.point.u, cp.point.v}},
+                                {"radius", radius},
+                                {"disk", disk}};
     std::cout << out.dump(2) << '\n';
     return kOk;
   }
-  std::cout << std::setprecision(6) << "closest limit-surface point: " << point_text(cp.position)
-            << "  (" << cp.distance << " from " << point_text(query) << ")\n"
+  std::cout << std::setprecision(6)
+            << "closest limit-surface point: " << point_text(cp.position, scale) << "  ("
+            << cp.distance << " from " << point_text(query) << ")\n"
             << "normal: " << point_text(cp.normal) << '\n'
-            << "ptex face " << cp.point.face << " at (u, v) = (" << cp.point.u << ", "
-            << cp.point.v << ")" << (cp.on_boundary ? ", on the surface's boundary" : "") << '\n'
+            << "ptex face " << cp.point.face << " at (u, v) = (" << cp.point.u << ", " << cp.point.v
+            << ")" << (cp.on_boundary ? ", on the surface's boundary" : "") << '\n'
             << "region spec: " << disk << '\n';
   return kOk;
 }

@@ -8,6 +8,7 @@
 #include <iostream>
 #include <nlohmann/json.hpp>
 
+#include "aim.h"
 #include "cli_common.h"
 #include "command.h"
 #include "compare_methods.h"
@@ -25,7 +26,6 @@
 #include "elastic/transfer/tangent_frames.h"
 #include "job_file.h"
 #include "map_job.h"
-#include "aim.h"
 #include "paste_preview.h"
 #include "verdict.h"
 
@@ -544,7 +544,8 @@ ELASTIC_COMMAND(
           "  elastic paste --source-image logo.png --source-anchor 0,1,0 \\\n"
           "      --target ../shared/meshes/spot.obj --target-region disk:0.0197,0.452,0.741,0.25 "
           "\\\n"
-          "      --target-anchor 0.0197,0.75,0.741 --boundary-offset anchor --out pasted/ --preview\n"
+          "      --target-anchor 0.0197,0.75,0.741 --boundary-offset anchor --out pasted/ "
+          "--preview\n"
           "`elastic locate` and `elastic region --preview` find the points (docs/cli.md, aiming).");
       return [a, &sub] { return elastic::cli::run_paste(*a, sub); };
     });

@@ -6,6 +6,7 @@
 #include <iostream>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <sstream>
 
 #include "aim.h"
 #include "cli_common.h"
@@ -33,7 +34,16 @@ struct RegionArgs {
   bool quiet = false;
 };
 
-nlohmann::json xyz(const Eigen::Vector3d& p) { return {p.x(), p.y(), p.z()}; }
+nlohmann::json xyz(const Eigen::Vector3d& p) {
+  return {p.x(), p.y(), p.z()};
+}
+
+/// "x,y,z" with 5 significant digits (ready to paste into a spec or --target-anchor).
+std::string text(const Eigen::Vector3d& p) {
+  std::ostringstream out;
+  out << std::setprecision(5) << p.x() << ',' << p.y() << ',' << p.z();
+  return out.str();
+}
 
 void render_preview(const RegionArgs& args, const LoadedSurface& loaded, const Region& region,
                     const RegionFigures& figures, const Eigen::Vector3d& up) {
@@ -62,9 +72,9 @@ void render_preview(const RegionArgs& args, const LoadedSurface& loaded, const R
   outline.look.wire_width_px = std::max(2.0, args.preview_size / 250.0);
   scene.objects.push_back(std::move(outline));
 
-  // The region fills 40% of the picture: the model around it shows where it is.
+  // The region fills 30% of the picture: the model around it shows where it is.
   const Camera camera = aim_camera(region.positions, figures.normal, up, args.fov,
-                                   args.preview_size, args.preview_size, 0.4);
+                                   args.preview_size, args.preview_size, 0.3);
   RenderOptions options;
   options.threads = args.threads;
   write_png(args.preview, render(scene, camera, options));
@@ -105,10 +115,8 @@ int run_region(const RegionArgs& args) {
             << ", geodesic radius " << figures.geodesic_radius << '\n'
             << "  " << region.num_vertices() << " vertices, " << region.num_triangles()
             << " triangles, " << region.boundary.size() << " on the boundary\n"
-            << "  centroid " << figures.centroid.transpose().format(Eigen::IOFormat(5, 0, ",", ","))
-            << ", normal " << figures.normal.transpose().format(Eigen::IOFormat(3, 0, ",", ","))
-            << ", anchor "
-            << figures.anchor.transpose().format(Eigen::IOFormat(5, 0, ",", ",")) << '\n'
+            << "  centroid " << text(figures.centroid) << ", normal " << text(figures.normal)
+            << ", anchor " << text(figures.anchor) << '\n'
             << "  up " << direction_name(up) << " (" << up_reason << ")\n";
   if (!args.preview.empty()) std::cout << "  wrote " << args.preview << '\n';
   return kOk;

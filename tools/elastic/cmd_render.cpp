@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "aim.h"
 #include "cli_common.h"
 #include "command.h"
 #include "elastic/core/error.h"
@@ -16,7 +17,6 @@
 #include "elastic/render/camera.h"
 #include "elastic/render/render.h"
 #include "job_file.h"
-#include "aim.h"
 #include "map_job.h"
 
 namespace elastic::cli {

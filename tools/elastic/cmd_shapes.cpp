@@ -82,8 +82,9 @@ int run_shapes(const ShapesArgs& args) {
         return kCantCreate;
       }
       const MeshValidation check = validate_mesh(mesh);
-      if (!args.quiet) std::cout << path.string() << ": " << name << ", V " << mesh.num_vertices() << ", F "
-                << mesh.num_faces() << ", boundary loops " << check.num_boundary_loops << '\n';
+      if (!args.quiet)
+        std::cout << path.string() << ": " << name << ", V " << mesh.num_vertices() << ", F "
+                  << mesh.num_faces() << ", boundary loops " << check.num_boundary_loops << '\n';
     }
   }
   return kOk;

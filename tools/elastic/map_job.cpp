@@ -149,9 +149,10 @@ std::unique_ptr<MapSession> run_map_job(const MapJob& job, const ProgressCallbac
   if (!job.source_image.empty()) {
     if (job.source_region != "boundary" && job.source_region != "rectangle" &&
         job.source_region != "ellipse") {
-      throw UsageError("--source-region: with --source-image it is 'rectangle' (default) or "
-                       "'ellipse', got '" +
-                       job.source_region + "'");
+      throw UsageError(
+          "--source-region: with --source-image it is 'rectangle' (default) or "
+          "'ellipse', got '" +
+          job.source_region + "'");
     }
     s.image =
         make_image_plane(job.source_image,
@@ -312,10 +313,9 @@ void print_map_summary(const MapJob& job, const MapSession& session) {
             << ", solver " << job.solver << ", " << x.iterations << " iterations, "
             << (x.converged ? "converged" : "NOT converged") << " (" << to_string(x.reason) << ")\n"
             << "solver energy: length springs " << x.length_energy << ", angle springs "
-            << x.angular_energy
-            << ", relative gradient " << x.relative_gradient << ", folds " << session.metrics.folds
-            << ", worst sigma_min " << session.metrics.sigma_min << ", boundary residual "
-            << x.boundary_residual << '\n'
+            << x.angular_energy << ", relative gradient " << x.relative_gradient << ", folds "
+            << session.metrics.folds << ", worst sigma_min " << session.metrics.sigma_min
+            << ", boundary residual " << x.boundary_residual << '\n'
             << "seconds: total " << session.seconds_total << ", solve " << x.solve_seconds << '\n';
 }
 

@@ -5,8 +5,8 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
-#include <limits>
 #include <functional>
+#include <limits>
 #include <sstream>
 
 #include "elastic/core/error.h"
@@ -166,9 +166,9 @@ struct Context {
   /// Projects a user point onto the surface; error when it is far from it. The error names the
   /// nearest surface point, and `suggest` (when given) turns that point into a ready spec, e.g.
   /// "disk:X,Y,Z,R", so that the user can copy it.
-  MeshLocation project(const Eigen::Vector3d& x, const std::string& what,
-                       const std::function<std::string(const Eigen::Vector3d&)>& suggest =
-                           {}) const {
+  MeshLocation project(
+      const Eigen::Vector3d& x, const std::string& what,
+      const std::function<std::string(const Eigen::Vector3d&)>& suggest = {}) const {
     if (!x.allFinite()) {
       throw InvalidInputError(options.name, what + " is not finite");
     }
@@ -235,12 +235,13 @@ Region disk_region(const Context& ctx, const RegionSpec& spec) {
     throw InvalidInputError(name,
                             "disk radius " + std::to_string(spec.radius) + " must be positive");
   }
-  const MeshLocation centre = ctx.project(spec.center, "disk centre", [&](const Eigen::Vector3d& q) {
-    std::ostringstream text;
-    text.precision(6);
-    text << "disk:" << q.x() << ',' << q.y() << ',' << q.z() << ',' << spec.radius;
-    return text.str();
-  });
+  const MeshLocation centre =
+      ctx.project(spec.center, "disk centre", [&](const Eigen::Vector3d& q) {
+        std::ostringstream text;
+        text.precision(6);
+        text << "disk:" << q.x() << ',' << q.y() << ',' << q.z() << ',' << spec.radius;
+        return text.str();
+      });
   const regions_detail::HeatGeodesics heat(ctx.tess.positions, ctx.tess.triangles, name);
   const Eigen::VectorXd distance = heat.distance(centre);
   CutMesh cut = ctx.cut_mesh();

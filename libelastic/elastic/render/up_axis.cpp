@@ -103,8 +103,9 @@ UpAxisGuess guess_up_axis(const std::vector<Eigen::Vector3d>& points,
     return make_guess(2, 1, std::move(footprints), reason.str());
   }
   if (opposite >= options.symmetric_ratio * *best) {
-    reason << "both ends of " << "xyz"[axis] << " are bases (" << 100.0 * footprints[2 * axis]
-           << "% and " << 100.0 * footprints[2 * axis + 1] << "% of the box); + taken";
+    reason << "both ends of "
+           << "xyz"[axis] << " are bases (" << 100.0 * footprints[2 * axis] << "% and "
+           << 100.0 * footprints[2 * axis + 1] << "% of the box); + taken";
     return make_guess(axis, 1, std::move(footprints), reason.str());
   }
   const int sign = index % 2 == 0 ? 1 : -1;
@@ -131,8 +132,8 @@ Eigen::Vector3d parse_up_direction(const std::string& text, const std::string& n
       d.allFinite() && d.norm() > 0.0) {
     return d.normalized();
   }
-  throw InvalidInputError(name, "expected x, y, z, -x, -y, -z or X,Y,Z (non-zero), got '" +
-                                    text + "'");
+  throw InvalidInputError(name,
+                          "expected x, y, z, -x, -y, -z or X,Y,Z (non-zero), got '" + text + "'");
 }
 
 }  // namespace elastic

@@ -24,18 +24,18 @@
 namespace elastic {
 
 struct UpAxisOptions {
-  double base_slab = 0.03;        ///< slab above the lowest point, fraction of the box extent
-  double flat_ratio = 1e-3;       ///< extent below this fraction of the largest: flat
+  double base_slab = 0.03;   ///< slab above the lowest point, fraction of the box extent
+  double flat_ratio = 1e-3;  ///< extent below this fraction of the largest: flat
   /// Smallest footprint (fraction of the cross-section) to trust: a sphere's lowest 3% is a disc
   /// of 9% of its box's cross-section (radius^2 = 2h - h^2 with h = 0.06 of a unit radius), and a
   /// base should stand out from that.
   double min_footprint = 0.12;
-  double symmetric_ratio = 0.8;   ///< opposite ends within this ratio: symmetric, take +
+  double symmetric_ratio = 0.8;  ///< opposite ends within this ratio: symmetric, take +
 };
 
 struct UpAxisGuess {
-  int axis = 2;                                       ///< 0, 1, 2 for x, y, z
-  int sign = 1;                                       ///< +1 or -1
+  int axis = 2;                                          ///< 0, 1, 2 for x, y, z
+  int sign = 1;                                          ///< +1 or -1
   Eigen::Vector3d direction = Eigen::Vector3d::UnitZ();  ///< sign * e_axis
   /// Footprint of each signed axis as up: [+x, -x, +y, -y, +z, -z], fractions in [0, 1].
   std::vector<double> footprints;
