@@ -127,6 +127,28 @@ TEST(Aiming, RegionReportsItsFiguresAndPreviewsItWithItsSurroundings) {
   EXPECT_NE(text.out.find("up +z"), std::string::npos) << text.out;
 }
 
+/// Pixels covered by the surface (opaque over a --transparent background).
+double surface_fraction(const Image& image) {
+  int surface = 0;
+  for (const Eigen::Vector4f& p : image.pixels) surface += p.w() > 0.5f;
+  return static_cast<double>(surface) / static_cast<double>(image.pixels.size());
+}
+
+TEST(Aiming, RenderFovZoomsFromTheSameEye) {
+  const fs::path dir = test::scratch_dir("aim_render_fov");
+  const std::string base =
+      "render -q " + mesh("cap_quads.obj") + " --size 120x120 --samples 1 --transparent ";
+  ASSERT_EQ(elastic(base + "--out " + (dir / "wide.png").string(), dir).code, 0);
+  ASSERT_EQ(elastic(base + "--fov 70 --out " + (dir / "wider.png").string(), dir).code, 0);
+  ASSERT_EQ(elastic(base + "--fov 10 --out " + (dir / "zoom.png").string(), dir).code, 0);
+  const double wide = surface_fraction(read_image(dir / "wide.png"));
+  // 35 degrees frames the whole cap with a margin; 70 shows it smaller, 10 fills the picture.
+  EXPECT_GT(wide, 0.2);
+  EXPECT_LT(wide, 0.9);
+  EXPECT_LT(surface_fraction(read_image(dir / "wider.png")), 0.5 * wide);
+  EXPECT_GT(surface_fraction(read_image(dir / "zoom.png")), 0.97);
+}
+
 TEST(Aiming, PasteHelpExplainsAnchorsAndOrientation) {
   const fs::path dir = test::scratch_dir("aim_help");
   const CliRun help = elastic("paste --help", dir);

@@ -321,7 +321,8 @@ TEST(Cli, EverySubcommandHasHelpWithAnExample) {
   const fs::path dir = test::scratch_dir("cli_help");
   const CliRun top = elastic("--help", dir);
   ASSERT_EQ(top.code, 0);
-  for (const char* command : {"paste", "map", "sample", "compare", "render", "info", "shapes"}) {
+  for (const char* command :
+       {"paste", "map", "sample", "compare", "render", "info", "shapes", "locate", "region"}) {
     SCOPED_TRACE(command);
     EXPECT_NE(top.out.find(command), std::string::npos);
     const CliRun help = elastic(std::string(command) + " --help", dir);
