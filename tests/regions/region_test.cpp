@@ -293,6 +293,45 @@ std::string error_of(F&& f) {
   return "no error";
 }
 
+/// A five-pointed star around (cx, cy) on z = 0: outer radius r, inner radius ratio * r.
+std::vector<Eigen::Vector3d> star(double cx, double cy, double r, double ratio) {
+  std::vector<Eigen::Vector3d> p;
+  for (int k = 0; k < 10; ++k) {
+    const double a = kPi / 2 + k * kPi / 5, rk = k % 2 == 0 ? r : ratio * r;
+    p.emplace_back(cx + rk * std::cos(a), cy + rk * std::sin(a), 0.0);
+  }
+  return p;
+}
+
+// Stars with sharp tips (36 degrees and less) and reflex notches: on a plane the sides are
+// straight, so the region's area and perimeter are the polygon's (shoelace formula). The heat
+// method's traced sides wound into each other at the tips and notches ("the curve crosses itself").
+TEST(PointsRegion, SharpStarsOnPlanesAreThePolygon) {
+  for (const ShapeFaces faces : {ShapeFaces::Quads, ShapeFaces::Triangles}) {
+    const Fixture fx(make_plane({.faces = faces, .resolution = 8}));
+    for (const double ratio : {0.38, 0.3, 0.2}) {
+      const std::vector<Eigen::Vector3d> p = star(0.05, -0.03, 0.8, ratio);
+      double area = 0.0, perimeter = 0.0;
+      for (size_t i = 0; i < p.size(); ++i) {
+        const Eigen::Vector3d& a = p[i];
+        const Eigen::Vector3d& b = p[(i + 1) % p.size()];
+        area += 0.5 * (a.x() * b.y() - a.y() * b.x());
+        perimeter += (b - a).norm();
+      }
+      SCOPED_TRACE("ratio " + std::to_string(ratio) +
+                   (faces == ShapeFaces::Quads ? " quads" : " triangles"));
+      try {
+        const Region region = make_region(*fx.projector, points(p));
+        EXPECT_NEAR(region.area(), area, 1e-6 * area);
+        // The snap that avoids sliver triangles moves curve points by up to 1e-3 of an edge.
+        EXPECT_NEAR(region.boundary_curve().length(), perimeter, 1e-4 * perimeter);
+      } catch (const std::exception& e) {
+        ADD_FAILURE() << e.what();
+      }
+    }
+  }
+}
+
 TEST(RegionErrors, CurveCrossesItself) {
   const Fixture fx(plane_mesh());
   const std::string msg = error_of([&] {

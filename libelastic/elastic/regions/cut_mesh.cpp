@@ -94,7 +94,8 @@ CutMesh::CutMesh(const LimitSurface& surface, const LimitTessellation& tess,
       points(tess.points),
       triangles(tess.triangles),
       face(tess.triangle_face),
-      uv(std::move(corner_uv)),
+      uv(corner_uv),
+      origin_uv(std::move(corner_uv)),
       surface_(&surface),
       name_(std::move(name)) {
   const int nt = num_triangles();

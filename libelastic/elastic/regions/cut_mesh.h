@@ -99,6 +99,10 @@ class CutMesh {
   std::vector<std::array<Eigen::Vector2d, 3>> uv;
   std::vector<std::array<Eigen::Vector2d, 3>> tex;  ///< empty unless enable_texture_chart()
   std::vector<int> origin;  ///< tessellation triangle each triangle came from
+  /// The corners' (u, v) of every tessellation triangle as it was before any cut: barycentric
+  /// coordinates in a tessellation triangle (MeshLocation of the tessellation) interpolate these,
+  /// not `uv`, whose entry for that index is one of the pieces once the triangle is split.
+  std::vector<std::array<Eigen::Vector2d, 3>> origin_uv;
   std::vector<std::vector<int>> vertex_triangles;
   std::vector<std::vector<int>> children;  ///< per tessellation triangle, the triangles cut from it
   std::vector<char> on_curve;              ///< per vertex

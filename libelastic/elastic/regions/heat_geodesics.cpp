@@ -13,17 +13,6 @@ namespace {
 
 using Triplets = std::vector<Eigen::Triplet<double>>;
 
-/// Vertices with a non-negligible weight in a location.
-std::vector<int> support(const MeshLocation& p, const std::vector<Eigen::Vector3i>& tri) {
-  std::vector<int> out;
-  for (int k = 0; k < 3; ++k) {
-    if (p.bary[k] > 0.0) {
-      out.push_back(tri[static_cast<size_t>(p.triangle)][k]);
-    }
-  }
-  return out;
-}
-
 }  // namespace
 
 HeatGeodesics::HeatGeodesics(const std::vector<Eigen::Vector3d>& positions,
@@ -32,7 +21,6 @@ HeatGeodesics::HeatGeodesics(const std::vector<Eigen::Vector3d>& positions,
   const int nv = static_cast<int>(x_.size());
   Triplets lap, mass;
   double total_edge = 0.0;
-  vertex_triangles_.resize(x_.size());
   for (size_t t = 0; t < tri_.size(); ++t) {
     const Eigen::Vector3i& v = tri_[t];
     const Eigen::Vector3d normal =
@@ -40,7 +28,6 @@ HeatGeodesics::HeatGeodesics(const std::vector<Eigen::Vector3d>& positions,
             .cross(x_[static_cast<size_t>(v[2])] - x_[static_cast<size_t>(v[0])]);
     const double double_area = normal.norm();
     for (int k = 0; k < 3; ++k) {
-      vertex_triangles_[static_cast<size_t>(v[k])].push_back(static_cast<int>(t));
       const int i = v[k], j = v[(k + 1) % 3], l = v[(k + 2) % 3];
       total_edge += (x_[static_cast<size_t>(j)] - x_[static_cast<size_t>(i)]).norm();
       mass.emplace_back(i, i, double_area / 6.0);
@@ -200,160 +187,6 @@ Eigen::VectorXd HeatGeodesics::distance(const MeshLocation& source) const {
     phi.array() -= offsets[offsets.size() / 2];
   }
   return phi;
-}
-
-std::vector<int> HeatGeodesics::triangles_at(const MeshLocation& p) const {
-  const std::vector<int> s = support(p, tri_);
-  if (s.size() == 3) {
-    return {p.triangle};
-  }
-  std::vector<int> out;
-  for (int t : vertex_triangles_[static_cast<size_t>(s[0])]) {
-    const Eigen::Vector3i& v = tri_[static_cast<size_t>(t)];
-    bool all = true;
-    for (int w : s) {
-      all = all && (v[0] == w || v[1] == w || v[2] == w);
-    }
-    if (all) {
-      out.push_back(t);
-    }
-  }
-  return out;
-}
-
-Eigen::Vector3d HeatGeodesics::bary_in(const MeshLocation& p, int t) const {
-  Eigen::Vector3d b = Eigen::Vector3d::Zero();
-  const Eigen::Vector3i& from = tri_[static_cast<size_t>(p.triangle)];
-  const Eigen::Vector3i& to = tri_[static_cast<size_t>(t)];
-  for (int k = 0; k < 3; ++k) {
-    if (p.bary[k] <= 0.0) {
-      continue;
-    }
-    for (int l = 0; l < 3; ++l) {
-      if (to[l] == from[k]) {
-        b[l] = p.bary[k];
-      }
-    }
-  }
-  return b;
-}
-
-std::vector<PathNode> HeatGeodesics::trace_path(const MeshLocation& from,
-                                                const MeshLocation& to) const {
-  const Eigen::VectorXd u = heat(to);
-  const std::vector<int> target = support(to, tri_);
-  auto holds_target = [&](int t) {
-    const Eigen::Vector3i& v = tri_[static_cast<size_t>(t)];
-    return std::all_of(target.begin(), target.end(),
-                       [&](int w) { return v[0] == w || v[1] == w || v[2] == w; });
-  };
-  auto value = [&](const MeshLocation& p) {
-    double s = 0.0;
-    for (int k = 0; k < 3; ++k) {
-      s += p.bary[k] * u[tri_[static_cast<size_t>(p.triangle)][k]];
-    }
-    return s;
-  };
-  std::vector<PathNode> path;
-  MeshLocation cur = from;
-  const size_t limit = 4 * tri_.size() + 64;
-  for (size_t step = 0; step < limit; ++step) {
-    const std::vector<int> cands = triangles_at(cur);
-    for (int t : cands) {
-      if (holds_target(t)) {
-        path.push_back({cur, t});
-        return path;
-      }
-    }
-    // Move up the heat gradient across the candidate triangle the gradient points into.
-    int best = -1;
-    double best_progress = 0.0;
-    Eigen::Vector3d best_bary;
-    for (int t : cands) {
-      const Eigen::Vector3d g = gradient(t, u);
-      if (g.norm() == 0.0) {
-        continue;
-      }
-      const Eigen::Vector3d b = bary_in(cur, t);
-      const Eigen::Vector3i& v = tri_[static_cast<size_t>(t)];
-      const Eigen::Vector3d& x0 = x_[static_cast<size_t>(v[0])];
-      const Eigen::Vector3d& x1 = x_[static_cast<size_t>(v[1])];
-      const Eigen::Vector3d& x2 = x_[static_cast<size_t>(v[2])];
-      const Eigen::Vector3d normal = (x1 - x0).cross(x2 - x0);
-      const double double_area = normal.norm();
-      if (double_area == 0.0) {
-        continue;
-      }
-      const Eigen::Vector3d n = normal / double_area;
-      // Rate of change of the barycentric coordinates along g (grad lambda_i = n x e_i / 2A).
-      const Eigen::Vector3d db(g.dot(n.cross(x2 - x1)), g.dot(n.cross(x0 - x2)),
-                               g.dot(n.cross(x1 - x0)));
-      const Eigen::Vector3d rate = db / double_area;
-      const double tiny = 1e-12 * rate.cwiseAbs().maxCoeff();
-      bool enters = true;
-      double s = std::numeric_limits<double>::infinity();
-      int exit = -1;
-      for (int k = 0; k < 3; ++k) {
-        if (rate[k] >= -tiny) {
-          continue;
-        }
-        if (b[k] <= 0.0) {
-          enters = false;  // the gradient points out of t through this corner's opposite edge
-          break;
-        }
-        const double sk = b[k] / -rate[k];
-        if (sk < s) {
-          s = sk;
-          exit = k;
-        }
-      }
-      if (!enters || exit < 0) {
-        continue;
-      }
-      const double progress = s * g.norm();
-      if (progress > best_progress) {
-        best_progress = progress;
-        best = t;
-        Eigen::Vector3d nb = (b + s * rate).cwiseMax(0.0);
-        nb[exit] = 0.0;
-        // Snap coordinates within 1e-7 of zero so the path meets vertices instead of crawling near
-        // them.
-        for (int k = 0; k < 3; ++k) {
-          nb[k] = nb[k] < 1e-7 ? 0.0 : nb[k];
-        }
-        best_bary = nb / nb.sum();
-      }
-    }
-    if (best >= 0) {
-      path.push_back({cur, best});
-      cur = MeshLocation{best, best_bary};
-      continue;
-    }
-    // The gradient points out of every triangle at cur (a ridge of u along an edge or at a vertex):
-    // move along an edge to the neighbouring vertex of largest heat.
-    const double here = value(cur);
-    int move_to = -1, move_tri = -1;
-    double best_u = here;
-    for (int t : cands) {
-      for (int k = 0; k < 3; ++k) {
-        const int w = tri_[static_cast<size_t>(t)][k];
-        if (u[w] > best_u) {
-          best_u = u[w];
-          move_to = w;
-          move_tri = t;
-        }
-      }
-    }
-    if (move_to < 0) {
-      throw NumericalError(name_,
-                           "cannot trace a shortest path on the surface (stuck at a heat maximum)");
-    }
-    path.push_back({cur, move_tri});
-    const Eigen::Vector3i& v = tri_[static_cast<size_t>(move_tri)];
-    cur =
-        MeshLocation{move_tri, Eigen::Vector3d(v[0] == move_to, v[1] == move_to, v[2] == move_to)};
-  }
-  throw NumericalError(name_, "cannot trace a shortest path on the surface (too many steps)");
 }
 
 }  // namespace elastic::regions_detail

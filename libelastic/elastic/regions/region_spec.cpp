@@ -12,6 +12,7 @@
 #include "elastic/core/error.h"
 #include "elastic/projection/closest_point.h"
 #include "elastic/regions/cut_mesh.h"
+#include "elastic/regions/exact_geodesics.h"
 #include "elastic/regions/heat_geodesics.h"
 
 namespace elastic {
@@ -343,6 +344,34 @@ Region disk_region(const Context& ctx, const RegionSpec& spec) {
   return regions_detail::make_region_from_patch(cut, comps[static_cast<size_t>(chosen)], topo);
 }
 
+bool in_face(const CutMesh& cut, int v, int face) {
+  for (int t : cut.vertex_triangles[static_cast<size_t>(v)]) {
+    if (cut.face[static_cast<size_t>(t)] == face) {
+      return true;
+    }
+  }
+  return false;
+}
+
+/// A ptex face with triangles at both a and b, or -1 (then the walk reports the missing face).
+int common_face(const CutMesh& cut, int a, int b) {
+  for (int t : cut.vertex_triangles[static_cast<size_t>(a)]) {
+    if (in_face(cut, b, cut.face[static_cast<size_t>(t)])) {
+      return cut.face[static_cast<size_t>(t)];
+    }
+  }
+  return -1;
+}
+
+Eigen::Vector2d coordinate_in_face(const CutMesh& cut, int v, int face) {
+  for (int t : cut.vertex_triangles[static_cast<size_t>(v)]) {
+    if (cut.face[static_cast<size_t>(t)] == face) {
+      return cut.chart_coordinate(Chart::Ptex, t, v);
+    }
+  }
+  return cut.points[static_cast<size_t>(v)].uv();
+}
+
 /// Embeds a closed chain of curve points (each a location in a tessellation triangle that also
 /// holds the next point) and walks the straight segments between them in `chart`.
 void embed_curve(CutMesh& cut, const std::vector<MeshLocation>& nodes, Chart chart,
@@ -355,8 +384,10 @@ void embed_curve(CutMesh& cut, const std::vector<MeshLocation>& nodes, Chart cha
     int v = -1;
     Eigen::Vector2d c = Eigen::Vector2d::Zero();
     if (chart == Chart::Ptex) {
+      // n.triangle is a tessellation triangle: its original corners, not the piece of it that
+      // an earlier insertion left under that index.
       const Eigen::Vector2d uv =
-          regions_detail::interpolate(cut.uv[static_cast<size_t>(n.triangle)], n.bary);
+          regions_detail::interpolate(cut.origin_uv[static_cast<size_t>(n.triangle)], n.bary);
       v = cut.insert_point(n.triangle, uv, kSnap);
     } else {
       // Texture chart: locate the polygon point among the current triangles (earlier insertions may
@@ -423,8 +454,15 @@ void embed_curve(CutMesh& cut, const std::vector<MeshLocation>& nodes, Chart cha
   }
   for (size_t i = 0; i < verts.size(); ++i) {
     const size_t j = (i + 1) % verts.size();
-    const int face = chart == Chart::Ptex ? cut.face[static_cast<size_t>(seg[i])] : -1;
-    cut.walk(verts[i], coords[i], verts[j], chart, face, kSnap);
+    int face = chart == Chart::Ptex ? cut.face[static_cast<size_t>(seg[i])] : -1;
+    Eigen::Vector2d from = coords[i];
+    if (chart == Chart::Ptex && !in_face(cut, verts[j], face)) {
+      // A snap moved the next point off the segment's ptex face (onto a vertex of the neighbour
+      // face): walk in a face that holds both ends instead.
+      face = common_face(cut, verts[i], verts[j]);
+      from = coordinate_in_face(cut, verts[i], face);
+    }
+    cut.walk(verts[i], from, verts[j], chart, face, kSnap);
   }
 }
 
@@ -455,10 +493,22 @@ Region points_region(const Context& ctx, const RegionSpec& spec) {
                             "the curve needs at least 3 distinct points on the surface, got " +
                                 std::to_string(locs.size()));
   }
+  // The sides are exact polyhedral shortest paths on the tessellation (exact_geodesics.h explains
+  // why not the heat method's traced paths).
+  // The search for each side is confined to the band of paths at most 50% longer than the
+  // shortest (plus four edges for the heat distance's error) around it.
   const regions_detail::HeatGeodesics heat(ctx.tess.positions, ctx.tess.triangles, name);
+  regions_detail::ExactGeodesics geodesics(ctx.tess.positions, ctx.tess.triangles, name);
+  std::vector<Eigen::VectorXd> dist(locs.size());
+  for (size_t i = 0; i < locs.size(); ++i) {
+    dist[i] = heat.distance(locs[i]);
+  }
   std::vector<MeshLocation> nodes;
   for (size_t i = 0; i < locs.size(); ++i) {
-    const auto path = heat.trace_path(locs[i], locs[(i + 1) % locs.size()]);
+    const size_t j = (i + 1) % locs.size();
+    const std::vector<char> band = regions_detail::geodesic_band(
+        ctx.tess.triangles, dist[i], dist[j], 0.5, 4.0 * heat.mean_edge_length());
+    const auto path = geodesics.path(locs[i], locs[j], band);
     for (const auto& node : path) {
       // Express the node in the triangle that holds the segment leaving it.
       MeshLocation m{node.segment_triangle, Eigen::Vector3d::Zero()};
