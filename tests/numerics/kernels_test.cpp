@@ -66,16 +66,14 @@ TEST(ConjugateGradient, MultigridPreconditionedSolveMatchesTheFactorisation) {
   std::uniform_real_distribution<double> weight(0.5, 4.0);
   std::vector<double> w(n * n);
   for (double& x : w) x = weight(rng);
-  const Eigen::SparseMatrix<double> l = graph_laplacian(
-      grid_graph(n), interior_rows(n), [&](int a, int b) { return w[a] * w[b]; });
+  const Eigen::SparseMatrix<double> l =
+      graph_laplacian(grid_graph(n), interior_rows(n), [&](int a, int b) { return w[a] * w[b]; });
   Eigen::VectorXd b = Eigen::VectorXd::Random(l.rows());
   const Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> factor(l);
   const Eigen::VectorXd exact = factor.solve(b);
 
   const Multigrid multigrid(l);
-  const LinearOperator apply = [&](const Eigen::VectorXd& v, Eigen::VectorXd& out) {
-    out = l * v;
-  };
+  const LinearOperator apply = [&](const Eigen::VectorXd& v, Eigen::VectorXd& out) { out = l * v; };
   const LinearOperator precondition = [&](const Eigen::VectorXd& v, Eigen::VectorXd& out) {
     out = multigrid.apply(v);
   };
@@ -99,7 +97,8 @@ TEST(ConjugateGradient, MultigridPreconditionedSolveMatchesTheFactorisation) {
 TEST(ConjugateGradient, ZeroRightHandSideIsSolvedAtOnce) {
   const LinearOperator identity = [](const Eigen::VectorXd& v, Eigen::VectorXd& out) { out = v; };
   Eigen::VectorXd x;
-  const ConjugateGradientResult r = conjugate_gradient(identity, identity, Eigen::VectorXd::Zero(5), x);
+  const ConjugateGradientResult r =
+      conjugate_gradient(identity, identity, Eigen::VectorXd::Zero(5), x);
   EXPECT_TRUE(r.converged);
   EXPECT_EQ(r.iterations, 0);
   EXPECT_EQ(x.norm(), 0.0);
