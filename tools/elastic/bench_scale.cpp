@@ -119,9 +119,10 @@ int run_scale(const ScaleArgs& args, const CLI::App& sub) {
         << "|---:|---:|---:|---:|---:|---:|---:|---:|\n";
   for (const nlohmann::json& c : report["sizes"]) {
     const nlohmann::json& t = c["seconds"];
-    table << std::setprecision(3) << "| " << c["particles"] << " | " << t["total"] << " | "
-          << t["loading"] << " | " << t["sampling"] << " | " << t["naive_map"] << " | "
-          << t["solve"] << " | " << t["lscm"] << " | " << c["ratio"] << " |\n";
+    const auto d = [](const nlohmann::json& v) { return v.get<double>(); };
+    table << std::setprecision(3) << "| " << c["particles"] << " | " << d(t["total"]) << " | "
+          << d(t["loading"]) << " | " << d(t["sampling"]) << " | " << d(t["naive_map"]) << " | "
+          << d(t["solve"]) << " | " << d(t["lscm"]) << " | " << d(c["ratio"]) << " |\n";
   }
   write_report(args.report, report);
   std::cout << table.str();
