@@ -1,6 +1,6 @@
 # cmake -P script: a library folder only includes folders above it in the data flow
 # (docs/architecture.md); render/ only uses core/, mesh/ and image/.
-set(order core mesh image shapes surface projection regions particles sampling solvers mapping
+set(order core numerics mesh image shapes surface projection regions particles sampling solvers mapping
           metrics baselines transfer)
 file(GLOB_RECURSE files ${ROOT}/libelastic/elastic/*.h ${ROOT}/libelastic/elastic/*.cpp)
 set(violations "")

@@ -172,6 +172,42 @@ TEST(AdaptiveSampling, SphereCapStaysValid) {
   EXPECT_NEAR(sampled.grid.num_particles(), 600.0, 30.0);
 }
 
+TEST(AdaptiveSampling, NewtonStepsReachTheSweepsEquilibriumInFewIterations) {
+  // The same fixed point of eq. 8 by two algorithms: tangent Newton steps (default) and the
+  // paper's Jacobi sweeps run far past their default budget, boundary held in both.
+  BumpFixture bump;
+  GridLayoutOptions layout;
+  layout.particles = 400;
+  const GridLayoutResult laid_out = layout_particle_grid(bump.region, layout);
+  AdaptiveSamplingOptions options;
+  options.move_boundary = false;
+  options.tolerance = 1e-7;
+  options.max_iterations = 300;
+  const AdaptiveSamplingResult newton =
+      adaptive_sampling(laid_out.grid, bump.region, bump.projector, options);
+  options.method = SamplingMethod::Jacobi;
+  options.max_iterations = 20000;
+  const AdaptiveSamplingResult jacobi =
+      adaptive_sampling(laid_out.grid, bump.region, bump.projector, options);
+  ASSERT_TRUE(newton.converged);
+  ASSERT_TRUE(jacobi.converged);
+  EXPECT_EQ(newton.newton_steps, newton.iterations);
+  EXPECT_GT(jacobi.iterations, 10 * newton.iterations);
+  // At the default tolerance the Newton steps need a handful of iterations.
+  AdaptiveSamplingOptions defaults;
+  defaults.move_boundary = false;
+  const AdaptiveSamplingResult quick =
+      adaptive_sampling(laid_out.grid, bump.region, bump.projector, defaults);
+  EXPECT_TRUE(quick.converged);
+  EXPECT_LT(quick.iterations, 30);
+  const Eigen::Matrix3Xd a = newton.grid.source_positions(), b = jacobi.grid.source_positions();
+  // Both stop within 1e-7 spacings per step; the sweeps' remaining distance to the fixed point is
+  // that over their contraction gap, still far below a thousandth of the spacing (~0.1).
+  EXPECT_LT((a - b).cwiseAbs().maxCoeff(), 1e-4);
+  EXPECT_EQ(newton.rejected_moves, 0);
+  expect_valid_faces(newton.grid, bump.surface, 0.0);
+}
+
 TEST(AdaptiveSampling, ProgressCanCancel) {
   BumpFixture bump;
   GridLayoutOptions layout;

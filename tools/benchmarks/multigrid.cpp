@@ -4,7 +4,7 @@
 //
 //   bench_multigrid --benchmark_filter=Apply/1000
 
-#include "elastic/solvers/multigrid.h"
+#include "elastic/numerics/multigrid.h"
 
 #include <benchmark/benchmark.h>
 

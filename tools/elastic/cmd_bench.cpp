@@ -15,6 +15,7 @@
 
 #include "bench_common.h"
 #include "bench_robustness.h"
+#include "bench_scale.h"
 #include "cli_common.h"
 #include "command.h"
 #include "compare_methods.h"
@@ -337,29 +338,36 @@ int run_bench(const BenchArgs& args, const CLI::App& sub) {
 }  // namespace
 }  // namespace elastic::cli
 
-ELASTIC_COMMAND(
-    "bench", "Benchmarks: `bench table1` (the paper's Table 1), `bench robustness` (real inputs)",
-    [](CLI::App& sub) {
-      auto a = std::make_shared<elastic::cli::BenchArgs>();
-      sub.require_subcommand(1);
-      CLI::App* table1 =
-          sub.add_subcommand("table1", "The paper's nine cases: ElasticPaint and the baselines");
-      table1->add_option("--cases", a->cases, "Cases file (JSON)");
-      table1->add_option("--root", a->root, "Folder the cases' mesh paths are relative to");
-      table1->add_option("--report", a->report, "Write the JSON report here");
-      table1->add_option("--markdown", a->markdown,
-                         "Write the Markdown results page here (default: stdout)");
-      table1->add_option("--runs", a->runs, "Runs per case (median seconds)")
-          ->check(CLI::Range(1, 100));
-      table1->add_option("--threads", a->threads, "Solver threads (0: all)")
-          ->check(CLI::Range(0, 1024));
-      table1->add_option("--only", a->only, "Run only the case with this name");
-      table1->add_flag("--extra", a->extra,
-                       "Also run the extra cases (real meshes of ../shared/meshes)");
-      table1->add_flag("--quiet,-q", a->quiet, "No progress lines on stderr");
-      const std::function<int()> robustness = elastic::cli::add_robustness_subcommand(sub);
-      return [a, table1, robustness] {
-        if (table1->parsed()) return elastic::cli::run_bench(*a, *table1);
-        return robustness();
-      };
-    });
+ELASTIC_COMMAND("bench",
+                "Benchmarks: `bench table1` (the paper's Table 1), `bench robustness` (real "
+                "inputs), `bench scale` (speed against CGAL's LSCM)",
+                [](CLI::App& sub) {
+                  auto a = std::make_shared<elastic::cli::BenchArgs>();
+                  sub.require_subcommand(1);
+                  CLI::App* table1 = sub.add_subcommand(
+                      "table1", "The paper's nine cases: ElasticPaint and the baselines");
+                  table1->add_option("--cases", a->cases, "Cases file (JSON)");
+                  table1->add_option("--root", a->root,
+                                     "Folder the cases' mesh paths are relative to");
+                  table1->add_option("--report", a->report, "Write the JSON report here");
+                  table1->add_option("--markdown", a->markdown,
+                                     "Write the Markdown results page here (default: stdout)");
+                  table1->add_option("--runs", a->runs, "Runs per case (median seconds)")
+                      ->check(CLI::Range(1, 100));
+                  table1->add_option("--threads", a->threads, "Solver threads (0: all)")
+                      ->check(CLI::Range(0, 1024));
+                  table1->add_option("--only", a->only, "Run only the case with this name");
+                  table1->add_flag("--extra", a->extra,
+                                   "Also run the extra cases (real meshes of ../shared/meshes)");
+                  table1->add_flag("--quiet,-q", a->quiet, "No progress lines on stderr");
+                  const std::function<int()> robustness =
+                      elastic::cli::add_robustness_subcommand(sub);
+                  CLI::App* scale_sub = nullptr;
+                  const std::function<int()> scale = elastic::cli::add_scale_subcommand(sub);
+                  scale_sub = sub.get_subcommand("scale");
+                  return [a, table1, robustness, scale, scale_sub] {
+                    if (table1->parsed()) return elastic::cli::run_bench(*a, *table1);
+                    if (scale_sub->parsed()) return scale();
+                    return robustness();
+                  };
+                });

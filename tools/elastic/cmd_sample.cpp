@@ -93,6 +93,8 @@ int run_sample(const SampleArgs& args, const CLI::App& sub) {
       {"adaptive",
        {{"enabled", args.adaptive},
         {"iterations", sampled.sampling.iterations},
+        {"newton_steps", sampled.sampling.newton_steps},
+        {"cg_iterations", sampled.sampling.cg_iterations},
         {"converged", sampled.sampling.converged},
         {"last_max_move", sampled.sampling.max_move},
         {"rejected_moves", sampled.sampling.rejected_moves},

@@ -20,6 +20,7 @@
 
 #include <Eigen/SparseLU>
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <memory>
 #include <numbers>
@@ -223,6 +224,7 @@ CgalFlattening flatten_region_cgal(const Region& region, BaselineKind kind,
   const std::vector<double> s = boundary_parameters(region);
   auto uvmap = mesh.add_property_map<VertexIndex, Point2>("v:elastic_uv", Point2(0, 0)).first;
   SMP::Error_code status = SMP::OK;
+  const auto start = std::chrono::steady_clock::now();
   switch (kind) {
     case BaselineKind::Lscm: {
       // Two pins make LSCM's minimiser unique; which vertices are pinned changes the map
@@ -270,6 +272,8 @@ CgalFlattening flatten_region_cgal(const Region& region, BaselineKind kind,
   }
 
   CgalFlattening result;
+  result.seconds_parameterize =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   result.uv.resize(static_cast<size_t>(nv));
   for (VertexIndex v : mesh.vertices()) {
     const Point2& p = uvmap[v];

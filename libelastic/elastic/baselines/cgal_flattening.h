@@ -40,6 +40,8 @@ struct CgalFlattening {
   std::vector<Eigen::Vector2d> uv;  ///< #V planar position of each region vertex
   int flipped_triangles = 0;        ///< triangles with non-positive signed area
   double scale = 1.0;               ///< factor applied to CGAL's output to match the 3D area
+  /// Wall time of CGAL's parameterize call alone (mesh building and checks excluded), seconds.
+  double seconds_parameterize = 0.0;
 };
 
 /// Flattens `region` with the CGAL parameterizer of `kind`.

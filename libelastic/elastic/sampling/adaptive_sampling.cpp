@@ -5,22 +5,19 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <memory>
 #include <random>
 #include <string>
 
 #include "elastic/core/error.h"
+#include "elastic/numerics/conjugate_gradient.h"
+#include "elastic/numerics/graph_laplacian.h"
+#include "elastic/numerics/multigrid.h"
 #include "elastic/sampling/boundary_sampler.h"
+#include "elastic/sampling/region_texcoords.h"
 
 namespace elastic {
 namespace {
-
-/// Compressed rows: items of row r are items[start[r] .. start[r+1]).
-struct Csr {
-  std::vector<int> start{0};
-  std::vector<int> items;
-  int begin(int r) const { return start[r]; }
-  int end(int r) const { return start[r + 1]; }
-};
 
 /// Sine of the angle at corner c of a face (neighbours a before, b after), signed by the normal at
 /// c: positive when the corner turns counter-clockwise seen from the normal side, 1 for a right
@@ -35,65 +32,7 @@ double corner_sine(const Eigen::Vector3d& xa, const Eigen::Vector3d& xc, const E
   return e1.cross(e2).dot(normal) / scale;
 }
 
-/// Texture coordinates at a surface point, interpolated in the region triangle (of the same ptex
-/// face) that contains its (u, v).
-class RegionTexcoords {
- public:
-  explicit RegionTexcoords(const Region& region) : region_(region) {
-    if (region.texcoords.empty()) {
-      return;
-    }
-    for (int t = 0; t < region.num_triangles(); ++t) {
-      const int f = region.triangle_face[t];
-      if (f >= static_cast<int>(by_face_.size())) {
-        by_face_.resize(f + 1);
-      }
-      by_face_[f].push_back(t);
-    }
-  }
-  /// False (and `uv` untouched) when no triangle of the point's ptex face holds it.
-  bool at(const SurfacePoint& p, Eigen::Vector2d& uv) const {
-    if (p.face < 0 || p.face >= static_cast<int>(by_face_.size())) {
-      return false;
-    }
-    int best = -1;
-    Eigen::Vector3d best_w = Eigen::Vector3d::Zero();
-    for (const int t : by_face_[p.face]) {
-      const auto& c = region_.triangle_uv[t];
-      const Eigen::Vector2d e1 = c[1] - c[0], e2 = c[2] - c[0], d = p.uv() - c[0];
-      const double det = e1.x() * e2.y() - e1.y() * e2.x();
-      if (det == 0.0) {
-        continue;
-      }
-      const double b1 = (d.x() * e2.y() - d.y() * e2.x()) / det;
-      const double b2 = (e1.x() * d.y() - e1.y() * d.x()) / det;
-      const Eigen::Vector3d w(1.0 - b1 - b2, b1, b2);
-      if (best < 0 || w.minCoeff() > best_w.minCoeff()) {
-        best = t;
-        best_w = w;
-      }
-    }
-    // A point slightly outside every triangle of its face (round-off on the region's edge) still
-    // takes the nearest one; farther ones keep their previous UV.
-    if (best < 0 || best_w.minCoeff() < -1e-3) {
-      return false;
-    }
-    const Eigen::Vector3i& tri = region_.triangles[best];
-    uv = best_w[0] * region_.texcoords[tri[0]] + best_w[1] * region_.texcoords[tri[1]] +
-         best_w[2] * region_.texcoords[tri[2]];
-    return true;
-  }
-
- private:
-  const Region& region_;
-  std::vector<std::vector<int>> by_face_;
-};
-
-}  // namespace
-
-AdaptiveSamplingResult adaptive_sampling(const ParticleGrid& input, const Region& region,
-                                         const SurfaceProjector& projector,
-                                         const AdaptiveSamplingOptions& options) {
+void validate(const ParticleGrid& input, const AdaptiveSamplingOptions& options) {
   const std::string& name = options.name;
   if (!(options.floor >= 0.0) || !(options.relaxation > 0.0 && options.relaxation <= 1.0) ||
       options.max_iterations < 0 || !(options.tolerance > 0.0) || !(options.jitter >= 0.0) ||
@@ -107,271 +46,559 @@ AdaptiveSamplingResult adaptive_sampling(const ParticleGrid& input, const Region
     throw InvalidInputError(name,
                             "the particle grid is incomplete (source points, boundary flags)");
   }
-  const LimitSurface& surface = projector.surface();
+}
 
-  AdaptiveSamplingResult result;
-  result.grid = input;
-  ParticleGrid& grid = result.grid;
+/// The state of the iteration: positions, surface points, normals and curvature weights of every
+/// particle, the boundary parameters, the grid's connectivity, and the candidate moves of one
+/// round. Each step of the algorithm is one member function.
+class Sampler {
+ public:
+  Sampler(ParticleGrid& grid, const Region& region, const SurfaceProjector& projector,
+          const AdaptiveSamplingOptions& options);
+
+  void jitter();
+  /// The floor's reference rbar0 and the clamp, from the current (laid-out) particles.
+  void fix_weight_reference();
+  /// Candidates of a Jacobi sweep of eq. 8 (all forces from the same state).
+  void jacobi_candidates();
+  /// Candidates of a tangent Newton step scaled by `step` (see newton_step).
+  void newton_candidates(double step);
+  /// One tangent Newton step with backtracking; false when no step length keeps every face valid
+  /// (nothing moved then). `largest` receives the largest move.
+  bool newton_step(double& largest);
+  /// Sequential, guarded acceptance of the candidates; returns the largest accepted move.
+  double accept_sequentially();
+  double mean_spring_length() const;
+  void write_back(AdaptiveSamplingResult& result) const;
+
+  long rejected = 0;
+  long cg_iterations = 0;
+
+ private:
+  void weight_at(const SurfacePoint& q, Eigen::Vector3d& n, double& w) const;
+  double weight(int p) const;
+  double min_sine_around(int p) const;
+  void project_interior();
+  void halfway(int p);
+  void evaluate_candidate_weights();
+  /// Tangent bases of the Newton step's unknowns and the multigrid of its preconditioner.
+  void prepare_newton();
+
+  ParticleGrid& grid_;
+  const Region& region_;
+  const SurfaceProjector& projector_;
+  const LimitSurface& surface_;
+  const AdaptiveSamplingOptions& options_;
+  int np_ = 0;
+  GraphAdjacency nbr_, faces_, vertex_faces_;
+  std::vector<int> loop_index_;
+  std::vector<double> s_;
+  std::unique_ptr<BoundarySampler> sampler_;
+  std::vector<Eigen::Vector3d> x_, normal_;
+  std::vector<double> r_;
+  std::vector<int> interior_;
+  double rbar_ = 0.0, cap_ = 0.0;
+
+  // Candidates of one round.
+  std::vector<Eigen::Vector3d> new_x_, new_normal_, targets_;
+  std::vector<SurfacePoint> new_sp_, hints_;
+  std::vector<ClosestPoint> projected_;
+  std::vector<double> new_s_, new_r_;
+  std::vector<char> moving_;
+
+  // Newton step: per particle its first unknown (-1: held), its number of unknowns (2 interior,
+  // 0 boundary) and tangent basis; the interior numbering of the preconditioner.
+  std::vector<int> unknown_, dim_;
+  std::vector<Eigen::Matrix<double, 3, 2>> basis_;
+  std::vector<int> interior_row_;
+  int unknowns_ = 0;
+  std::unique_ptr<Multigrid> multigrid_;
+  bool newton_ready_ = false;
+  Eigen::VectorXd delta_;  // the step, in unknowns
+};
+
+Sampler::Sampler(ParticleGrid& grid, const Region& region, const SurfaceProjector& projector,
+                 const AdaptiveSamplingOptions& options)
+    : grid_(grid),
+      region_(region),
+      projector_(projector),
+      surface_(projector.surface()),
+      options_(options),
+      np_(grid.num_particles()) {
   const GridMesh& mesh = grid.mesh;
-
   // Flat connectivity: neighbours, faces, faces around each vertex.
-  Csr nbr, faces, vertex_faces;
-  for (int p = 0; p < np; ++p) {
+  for (int p = 0; p < np_; ++p) {
     for (const auto v : mesh.vv_range(GridMesh::VertexHandle(p))) {
-      nbr.items.push_back(v.idx());
+      nbr_.items.push_back(v.idx());
     }
-    nbr.start.push_back(static_cast<int>(nbr.items.size()));
+    nbr_.start.push_back(static_cast<int>(nbr_.items.size()));
     for (const auto f : mesh.vf_range(GridMesh::VertexHandle(p))) {
-      vertex_faces.items.push_back(f.idx());
+      vertex_faces_.items.push_back(f.idx());
     }
-    vertex_faces.start.push_back(static_cast<int>(vertex_faces.items.size()));
+    vertex_faces_.start.push_back(static_cast<int>(vertex_faces_.items.size()));
   }
   for (const auto f : mesh.faces()) {
     for (const auto v : mesh.fv_range(f)) {
-      faces.items.push_back(v.idx());
+      faces_.items.push_back(v.idx());
     }
-    faces.start.push_back(static_cast<int>(faces.items.size()));
+    faces_.start.push_back(static_cast<int>(faces_.items.size()));
   }
-
   // Boundary bookkeeping: position of each boundary particle in the loop, and its parameter s.
-  std::vector<int> loop_index(np, -1);
+  loop_index_.assign(np_, -1);
   for (size_t k = 0; k < grid.boundary_loop.size(); ++k) {
-    loop_index[grid.boundary_loop[k]] = static_cast<int>(k);
+    loop_index_[grid.boundary_loop[k]] = static_cast<int>(k);
   }
-  for (int p = 0; p < np; ++p) {
-    if (grid.is_boundary[p] && loop_index[p] < 0) {
+  for (int p = 0; p < np_; ++p) {
+    if (grid.is_boundary[p] && loop_index_[p] < 0) {
       throw InvalidInputError(
-          name, "boundary particle " + std::to_string(p) + " is not in the boundary loop");
+          options.name, "boundary particle " + std::to_string(p) + " is not in the boundary loop");
     }
-  }
-  const int nb = static_cast<int>(grid.boundary_loop.size());
-  std::vector<double> s = grid.boundary_parameter;
-  std::unique_ptr<BoundarySampler> sampler;
-  if (nb > 0 && options.move_boundary) {
-    sampler = std::make_unique<BoundarySampler>(region, name);
-  }
-
-  std::vector<Eigen::Vector3d> x(np);
-  for (int p = 0; p < np; ++p) {
-    const auto& q = mesh.point(GridMesh::VertexHandle(p));
-    x[p] = Eigen::Vector3d(q[0], q[1], q[2]);
-  }
-  std::vector<SurfacePoint>& sp = grid.source_points;
-  std::vector<Eigen::Vector3d> normal(np);
-  std::vector<double> r(np);
-  // Normal and curvature weight r = sqrt((k1^2 + k2^2) / 2) at a surface point.
-  auto weight_at = [&](const SurfacePoint& q, Eigen::Vector3d& n, double& w) {
-    const SurfaceCurvature c = surface.curvature(q);
-    n = c.normal;
-    w = std::sqrt(0.5 * (c.k1 * c.k1 + c.k2 * c.k2));
-  };
-  tbb::parallel_for(0, np, [&](int p) { weight_at(sp[p], normal[p], r[p]); });
-
-  auto mean_spring_length = [&] {
-    double sum = 0.0;
-    for (const auto e : mesh.edges()) {
-      const auto h = mesh.halfedge_handle(e, 0);
-      sum += (x[mesh.to_vertex_handle(h).idx()] - x[mesh.from_vertex_handle(h).idx()]).norm();
-    }
-    return mesh.n_edges() > 0 ? sum / static_cast<double>(mesh.n_edges()) : 0.0;
-  };
-
-  // Smallest corner sine over the faces around p, given the current positions.
-  auto min_sine_around = [&](int p) {
-    double m = 1.0;
-    for (int k = vertex_faces.begin(p); k < vertex_faces.end(p); ++k) {
-      const int f = vertex_faces.items[k];
-      const int n = faces.end(f) - faces.begin(f);
-      const int* v = faces.items.data() + faces.begin(f);
-      for (int c = 0; c < n; ++c) {
-        const int a = v[(c + n - 1) % n], i = v[c], b = v[(c + 1) % n];
-        m = std::min(m, corner_sine(x[a], x[i], x[b], normal[i]));
-      }
-    }
-    return m;
-  };
-
-  // Candidate moves of one round, and their acceptance (sequential, in particle order).
-  std::vector<Eigen::Vector3d> new_x(np);
-  std::vector<SurfacePoint> new_sp(np);
-  std::vector<double> new_s(np, 0.0);
-  std::vector<Eigen::Vector3d> new_normal(np);
-  std::vector<double> new_r(np, 0.0);
-  std::vector<char> moving(np, 0);
-  long rejected = 0;
-
-  // Re-evaluates a halfway move of particle p (between its current state and the candidate).
-  auto halfway = [&](int p) {
-    if (grid.is_boundary[p]) {
-      const int k = loop_index[p];
-      double ds = new_s[p] - s[k];
-      ds -= std::round(ds);
-      const BoundarySampler::Sample smp = sampler->at(s[k] + 0.5 * ds);
-      new_x[p] = smp.position;
-      new_sp[p] = smp.point;
-      new_s[p] = smp.s;
-    } else {
-      const ClosestPoint cp = projector.closest(0.5 * (x[p] + new_x[p]), sp[p]);
-      new_x[p] = cp.position;
-      new_sp[p] = cp.point;
-    }
-  };
-
-  auto accept_moves = [&]() {
-    // Normals and weights at the candidate positions, in parallel; acceptance is sequential.
-    tbb::parallel_for(0, np, [&](int p) {
-      if (moving[p]) {
-        weight_at(new_sp[p], new_normal[p], new_r[p]);
-      }
-    });
-    double largest = 0.0;
-    for (int p = 0; p < np; ++p) {
-      if (!moving[p]) {
-        continue;
-      }
-      const double before = min_sine_around(p);
-      const Eigen::Vector3d old_x = x[p], old_n = normal[p];
-      const double old_r = r[p];
-      const SurfacePoint old_sp = sp[p];
-      bool ok = false;
-      for (int attempt = 0; attempt < 2 && !ok; ++attempt) {
-        if (attempt == 1) {
-          halfway(p);
-          weight_at(new_sp[p], new_normal[p], new_r[p]);
-        }
-        x[p] = new_x[p];
-        sp[p] = new_sp[p];
-        normal[p] = new_normal[p];
-        r[p] = new_r[p];
-        const double after = min_sine_around(p);
-        ok = after > 0.0 && (after > options.min_corner_sine || after >= before);
-      }
-      if (!ok) {
-        x[p] = old_x;
-        sp[p] = old_sp;
-        normal[p] = old_n;
-        r[p] = old_r;
-        ++rejected;
-        continue;
-      }
-      if (grid.is_boundary[p]) {
-        s[loop_index[p]] = new_s[p];
-      }
-      largest = std::max(largest, (x[p] - old_x).norm());
-    }
-    return largest;
-  };
-
-  // Interior particles, for the batched magnet.
-  std::vector<int> interior;
-  for (int p = 0; p < np; ++p) {
     if (!grid.is_boundary[p]) {
-      interior.push_back(p);
+      interior_.push_back(p);
     }
   }
-  std::vector<Eigen::Vector3d> targets(interior.size());
-  std::vector<SurfacePoint> hints(interior.size());
-  std::vector<ClosestPoint> projected(interior.size());
-  auto project_interior = [&] {
-    for (size_t k = 0; k < interior.size(); ++k) {
-      hints[k] = sp[interior[k]];
-    }
-    projector.closest(targets, projected, hints);
-    for (size_t k = 0; k < interior.size(); ++k) {
-      new_x[interior[k]] = projected[k].position;
-      new_sp[interior[k]] = projected[k].point;
-    }
-  };
-
-  double spacing = mean_spring_length();
-  if (!(spacing > 0.0)) {
-    throw InvalidInputError(name, "the particle grid has no springs");
+  s_ = grid.boundary_parameter;
+  if (!grid.boundary_loop.empty() && options.move_boundary) {
+    sampler_ = std::make_unique<BoundarySampler>(region, options.name);
   }
-
-  // Optional seeded jitter: a random tangent displacement of every interior particle.
-  if (options.jitter > 0.0 && !interior.empty()) {
-    std::mt19937_64 rng(options.seed);
-    std::uniform_real_distribution<double> uniform(-1.0, 1.0);
-    std::fill(moving.begin(), moving.end(), 0);
-    for (size_t k = 0; k < interior.size(); ++k) {
-      const int p = interior[k];
-      const Eigen::Vector3d& n = normal[p];
-      const Eigen::Vector3d t1 = n.unitOrthogonal(), t2 = n.cross(t1);
-      const double a = uniform(rng), b = uniform(rng);
-      targets[k] = x[p] + options.jitter * spacing * (a * t1 + b * t2);
-      moving[p] = 1;
-    }
-    project_interior();
-    accept_moves();
+  x_.resize(np_);
+  for (int p = 0; p < np_; ++p) {
+    const auto& q = mesh.point(GridMesh::VertexHandle(p));
+    x_[p] = Eigen::Vector3d(q[0], q[1], q[2]);
   }
+  normal_.resize(np_);
+  r_.resize(np_);
+  tbb::parallel_for(0, np_, [&](int p) { weight_at(grid.source_points[p], normal_[p], r_[p]); });
+  new_x_.resize(np_);
+  new_normal_.resize(np_);
+  new_sp_.resize(np_);
+  new_s_.assign(np_, 0.0);
+  new_r_.assign(np_, 0.0);
+  moving_.assign(np_, 0);
+  targets_.resize(interior_.size());
+  hints_.resize(interior_.size());
+  projected_.resize(interior_.size());
+}
 
-  // The floor's reference: the mean weight over the initial particles. The layout spreads them
-  // evenly over the surface, so this is (close to) the area mean of r over the region, and it stays
-  // fixed while the particles migrate (a mean over the moving particles would grow as they gather
-  // in curved parts and drain the flat parts further).
-  double rbar = 0.0;
-  for (int p = 0; p < np; ++p) {
-    rbar += r[p];
+// Normal and curvature weight r = sqrt((k1^2 + k2^2) / 2) at a surface point.
+void Sampler::weight_at(const SurfacePoint& q, Eigen::Vector3d& n, double& w) const {
+  const SurfaceCurvature c = surface_.curvature(q);
+  n = c.normal;
+  w = std::sqrt(0.5 * (c.k1 * c.k1 + c.k2 * c.k2));
+}
+
+// Weights (see the header): all 1 on a flat region, where eq. 8 degenerates to Laplacian
+// smoothing.
+double Sampler::weight(int p) const {
+  const double rp = cap_ > 0.0 ? std::min(r_[p], cap_) : r_[p];
+  return rbar_ > 0.0 ? rp + options_.floor * rbar_ : 1.0;
+}
+
+double Sampler::mean_spring_length() const {
+  const GridMesh& mesh = grid_.mesh;
+  double sum = 0.0;
+  for (const auto e : mesh.edges()) {
+    const auto h = mesh.halfedge_handle(e, 0);
+    sum += (x_[mesh.to_vertex_handle(h).idx()] - x_[mesh.from_vertex_handle(h).idx()]).norm();
   }
-  rbar /= np;
-  const double cap = options.max_weight > 0.0 ? options.max_weight * rbar : 0.0;
+  return mesh.n_edges() > 0 ? sum / static_cast<double>(mesh.n_edges()) : 0.0;
+}
 
-  for (int it = 0; it < options.max_iterations; ++it) {
-    // Weights (see the header): all 1 on a flat region, where eq. 8 degenerates to Laplacian
-    // smoothing.
-    std::vector<double> w(np);
-    for (int p = 0; p < np; ++p) {
-      const double rp = cap > 0.0 ? std::min(r[p], cap) : r[p];
-      w[p] = rbar > 0.0 ? rp + options.floor * rbar : 1.0;
+// Smallest corner sine over the faces around p, given the current positions.
+double Sampler::min_sine_around(int p) const {
+  double m = 1.0;
+  for (int k = vertex_faces_.start[p]; k < vertex_faces_.start[p + 1]; ++k) {
+    const int f = vertex_faces_.items[k];
+    const int n = faces_.start[f + 1] - faces_.start[f];
+    const int* v = faces_.items.data() + faces_.start[f];
+    for (int c = 0; c < n; ++c) {
+      const int a = v[(c + n - 1) % n], i = v[c], b = v[(c + 1) % n];
+      m = std::min(m, corner_sine(x_[a], x_[i], x_[b], normal_[i]));
     }
+  }
+  return m;
+}
 
-    auto force = [&](int p) {
-      Eigen::Vector3d f = Eigen::Vector3d::Zero();
-      double wsum = 0.0;
-      for (int k = nbr.begin(p); k < nbr.end(p); ++k) {
-        const int j = nbr.items[k];
-        f += w[j] * (x[j] - x[p]);
-        wsum += w[j];
+// The batched magnet: interior candidates from targets_, warm-started at the current points.
+void Sampler::project_interior() {
+  const std::vector<SurfacePoint>& sp = grid_.source_points;
+  for (size_t k = 0; k < interior_.size(); ++k) {
+    hints_[k] = sp[interior_[k]];
+  }
+  projector_.closest(targets_, projected_, hints_);
+  for (size_t k = 0; k < interior_.size(); ++k) {
+    new_x_[interior_[k]] = projected_[k].position;
+    new_sp_[interior_[k]] = projected_[k].point;
+  }
+}
+
+// Re-evaluates a halfway move of particle p (between its current state and the candidate).
+void Sampler::halfway(int p) {
+  if (grid_.is_boundary[p]) {
+    const int k = loop_index_[p];
+    double ds = new_s_[p] - s_[k];
+    ds -= std::round(ds);
+    const BoundarySampler::Sample smp = sampler_->at(s_[k] + 0.5 * ds);
+    new_x_[p] = smp.position;
+    new_sp_[p] = smp.point;
+    new_s_[p] = smp.s;
+  } else {
+    const ClosestPoint cp = projector_.closest(0.5 * (x_[p] + new_x_[p]), grid_.source_points[p]);
+    new_x_[p] = cp.position;
+    new_sp_[p] = cp.point;
+  }
+}
+
+void Sampler::evaluate_candidate_weights() {
+  tbb::parallel_for(0, np_, [&](int p) {
+    if (moving_[p]) {
+      weight_at(new_sp_[p], new_normal_[p], new_r_[p]);
+    }
+  });
+}
+
+double Sampler::accept_sequentially() {
+  // Normals and weights at the candidate positions, in parallel; acceptance is sequential.
+  evaluate_candidate_weights();
+  std::vector<SurfacePoint>& sp = grid_.source_points;
+  double largest = 0.0;
+  for (int p = 0; p < np_; ++p) {
+    if (!moving_[p]) {
+      continue;
+    }
+    const double before = min_sine_around(p);
+    const Eigen::Vector3d old_x = x_[p], old_n = normal_[p];
+    const double old_r = r_[p];
+    const SurfacePoint old_sp = sp[p];
+    bool ok = false;
+    for (int attempt = 0; attempt < 2 && !ok; ++attempt) {
+      if (attempt == 1) {
+        halfway(p);
+        weight_at(new_sp_[p], new_normal_[p], new_r_[p]);
       }
-      return wsum > 0.0 ? Eigen::Vector3d(f / wsum) : Eigen::Vector3d::Zero();
-    };
-    std::fill(moving.begin(), moving.end(), 0);
-    tbb::parallel_for(size_t{0}, interior.size(), [&](size_t k) {
-      const int p = interior[k];
-      const Eigen::Vector3d f = force(p);
-      // T_i: the tangent-plane component (eq. 8); the magnet below handles what remains of the
-      // normal.
-      targets[k] = x[p] + options.relaxation * (f - f.dot(normal[p]) * normal[p]);
-      moving[p] = 1;
-    });
-    project_interior();
-    if (sampler) {
-      const double length = sampler->length();
-      tbb::parallel_for(0, nb, [&](int k) {
-        const int p = grid.boundary_loop[k];
-        const BoundarySampler::Sample here = sampler->at(s[k]);
-        // Arc-length step from the force's component along the chord, at most a quarter of the gap
-        // to either neighbour so that two neighbours moving towards each other cannot meet or
-        // cross.
-        double ds = options.relaxation * force(p).dot(here.tangent) / length;
-        auto gap = [&](int other) {
-          double g = s[other] - s[k];
-          return g - std::floor(g);  // forward gap in [0, 1)
-        };
-        const double gap_next = nb > 1 ? gap((k + 1) % nb) : 1.0;
-        const double gap_prev = nb > 1 ? 1.0 - gap((k + nb - 1) % nb) : 1.0;
-        ds = std::clamp(ds, -0.25 * gap_prev, 0.25 * gap_next);
-        const BoundarySampler::Sample there = sampler->at(s[k] + ds);
-        new_x[p] = there.position;
-        new_sp[p] = there.point;
-        new_s[p] = there.s;
-        moving[p] = 1;
-      });
+      x_[p] = new_x_[p];
+      sp[p] = new_sp_[p];
+      normal_[p] = new_normal_[p];
+      r_[p] = new_r_[p];
+      const double after = min_sine_around(p);
+      ok = after > 0.0 && (after > options_.min_corner_sine || after >= before);
     }
-    const double largest = accept_moves();
-    spacing = mean_spring_length();
+    if (!ok) {
+      x_[p] = old_x;
+      sp[p] = old_sp;
+      normal_[p] = old_n;
+      r_[p] = old_r;
+      ++rejected;
+      continue;
+    }
+    if (grid_.is_boundary[p]) {
+      s_[loop_index_[p]] = new_s_[p];
+    }
+    largest = std::max(largest, (x_[p] - old_x).norm());
+  }
+  return largest;
+}
+
+// Optional seeded jitter: a random tangent displacement of every interior particle.
+void Sampler::jitter() {
+  if (!(options_.jitter > 0.0) || interior_.empty()) {
+    return;
+  }
+  const double spacing = mean_spring_length();
+  std::mt19937_64 rng(options_.seed);
+  std::uniform_real_distribution<double> uniform(-1.0, 1.0);
+  std::fill(moving_.begin(), moving_.end(), 0);
+  for (size_t k = 0; k < interior_.size(); ++k) {
+    const int p = interior_[k];
+    const Eigen::Vector3d& n = normal_[p];
+    const Eigen::Vector3d t1 = n.unitOrthogonal(), t2 = n.cross(t1);
+    const double a = uniform(rng), b = uniform(rng);
+    targets_[k] = x_[p] + options_.jitter * spacing * (a * t1 + b * t2);
+    moving_[p] = 1;
+  }
+  project_interior();
+  accept_sequentially();
+}
+
+// The floor's reference: the mean weight over the initial particles. The layout spreads them
+// evenly over the surface, so this is (close to) the area mean of r over the region, and it stays
+// fixed while the particles migrate (a mean over the moving particles would grow as they gather
+// in curved parts and drain the flat parts further).
+void Sampler::fix_weight_reference() {
+  double sum = 0.0;
+  for (int p = 0; p < np_; ++p) {
+    sum += r_[p];
+  }
+  rbar_ = np_ > 0 ? sum / np_ : 0.0;
+  cap_ = options_.max_weight > 0.0 ? options_.max_weight * rbar_ : 0.0;
+}
+
+void Sampler::jacobi_candidates() {
+  std::vector<double> w(np_);
+  for (int p = 0; p < np_; ++p) {
+    w[p] = weight(p);
+  }
+  auto force = [&](int p) {
+    Eigen::Vector3d f = Eigen::Vector3d::Zero();
+    double wsum = 0.0;
+    for (int k = nbr_.start[p]; k < nbr_.start[p + 1]; ++k) {
+      const int j = nbr_.items[k];
+      f += w[j] * (x_[j] - x_[p]);
+      wsum += w[j];
+    }
+    return wsum > 0.0 ? Eigen::Vector3d(f / wsum) : Eigen::Vector3d::Zero();
+  };
+  std::fill(moving_.begin(), moving_.end(), 0);
+  tbb::parallel_for(size_t{0}, interior_.size(), [&](size_t k) {
+    const int p = interior_[k];
+    const Eigen::Vector3d f = force(p);
+    // T_i: the tangent-plane component (eq. 8); the magnet handles what remains of the normal.
+    targets_[k] = x_[p] + options_.relaxation * (f - f.dot(normal_[p]) * normal_[p]);
+    moving_[p] = 1;
+  });
+  project_interior();
+  if (!sampler_) {
+    return;
+  }
+  const int nb = static_cast<int>(grid_.boundary_loop.size());
+  const double length = sampler_->length();
+  tbb::parallel_for(0, nb, [&](int k) {
+    const int p = grid_.boundary_loop[k];
+    const BoundarySampler::Sample here = sampler_->at(s_[k]);
+    // Arc-length step from the force's component along the chord, at most a quarter of the gap to
+    // either neighbour so that two neighbours moving towards each other cannot meet or cross.
+    double ds = options_.relaxation * force(p).dot(here.tangent) / length;
+    auto gap = [&](int other) {
+      double g = s_[other] - s_[k];
+      return g - std::floor(g);  // forward gap in [0, 1)
+    };
+    const double gap_next = nb > 1 ? gap((k + 1) % nb) : 1.0;
+    const double gap_prev = nb > 1 ? 1.0 - gap((k + nb - 1) % nb) : 1.0;
+    ds = std::clamp(ds, -0.25 * gap_prev, 0.25 * gap_next);
+    const BoundarySampler::Sample there = sampler_->at(s_[k] + ds);
+    new_x_[p] = there.position;
+    new_sp_[p] = there.point;
+    new_s_[p] = there.s;
+    moving_[p] = 1;
+  });
+}
+
+// The Newton step's preconditioner is built once, from the weights of the first step: it only has
+// to be spectrally close to the operator, and its set-up (aggregation, Galerkin products) is the
+// dearest part of a step on large grids.
+void Sampler::prepare_newton() {
+  unknown_.assign(np_, -1);
+  dim_.assign(np_, 0);
+  basis_.assign(np_, Eigen::Matrix<double, 3, 2>::Zero());
+  interior_row_.assign(np_, -1);
+  unknowns_ = 0;
+  int rows = 0;
+  for (int p = 0; p < np_; ++p) {
+    if (!grid_.is_boundary[p]) {
+      unknown_[p] = unknowns_;
+      dim_[p] = 2;
+      unknowns_ += 2;
+      interior_row_[p] = rows++;
+    }
+  }
+  multigrid_ = std::make_unique<Multigrid>(
+      graph_laplacian(nbr_, interior_row_, [&](int i, int j) { return weight(i) * weight(j); }));
+  newton_ready_ = true;
+}
+
+// The tangent Newton step on eq. 8. With the weights w frozen at the current positions, eq. 8 is
+// w_i^-1 times the tangential gradient of the quadratic energy
+//
+//     E(a) = 1/2 sum_{edges ij} w_i w_j |(x_i + B_i a_i) - (x_j + B_j a_j)|^2,
+//
+// a_i an interior particle's displacement in its tangent basis B_i (two unit tangents; boundary
+// particles are held). Its minimiser solves M a = -grad E(0) with M = B^T (L (x) I_3) B, L the
+// graph Laplacian with edge weights w_i w_j restricted to the interior rows (the boundary is a
+// Dirichlet condition): symmetric positive definite, solved by conjugate gradients preconditioned
+// with B^T L^-1 B (one multigrid V-cycle of the scalar L applied to x, y and z). If B were square
+// (a flat region) the preconditioner would be exact up to the V-cycle; on a curved region it drops
+// the normal part, which costs a few more iterations (4-13 on spot.obj). Where all weights are
+// equal and the surface is flat this is one exact solve of Laplacian smoothing's equilibrium, which
+// the Jacobi sweeps reach only after O(n) sweeps of one grid ring each; elsewhere it is repeated as
+// the weights follow the particles (a fixed-point iteration on w with a Newton step inside).
+void Sampler::newton_candidates(double step) {
+  if (step == 1.0) {
+    for (int p = 0; p < np_; ++p) {
+      if (dim_[p] == 2) {
+        const Eigen::Vector3d t1 = normal_[p].unitOrthogonal();
+        basis_[p].col(0) = t1;
+        basis_[p].col(1) = normal_[p].cross(t1);
+      }
+    }
+    std::vector<double> w(np_);
+    for (int p = 0; p < np_; ++p) {
+      w[p] = weight(p);
+    }
+    auto lift = [&](const Eigen::VectorXd& v, int p) -> Eigen::Vector3d {
+      return dim_[p] == 2 ? Eigen::Vector3d(basis_[p] * v.segment<2>(unknown_[p]))
+                          : Eigen::Vector3d::Zero();
+    };
+    auto drop = [&](const Eigen::Vector3d& f, int p, Eigen::VectorXd& out) {
+      if (dim_[p] == 2) {
+        out.segment<2>(unknown_[p]) = basis_[p].transpose() * f;
+      }
+    };
+    Eigen::VectorXd rhs(unknowns_);
+    tbb::parallel_for(0, np_, [&](int p) {
+      Eigen::Vector3d f = Eigen::Vector3d::Zero();
+      for (int k = nbr_.start[p]; k < nbr_.start[p + 1]; ++k) {
+        const int j = nbr_.items[k];
+        f += w[p] * w[j] * (x_[j] - x_[p]);
+      }
+      drop(f, p, rhs);
+    });
+    const LinearOperator apply_m = [&](const Eigen::VectorXd& v, Eigen::VectorXd& out) {
+      out.resize(v.size());
+      std::vector<Eigen::Vector3d> d(np_);
+      tbb::parallel_for(0, np_, [&](int p) { d[p] = lift(v, p); });
+      tbb::parallel_for(0, np_, [&](int p) {
+        if (dim_[p] == 0) {
+          return;
+        }
+        Eigen::Vector3d f = Eigen::Vector3d::Zero();
+        for (int k = nbr_.start[p]; k < nbr_.start[p + 1]; ++k) {
+          const int j = nbr_.items[k];
+          f += w[p] * w[j] * (d[p] - d[j]);
+        }
+        drop(f, p, out);
+      });
+    };
+    Multigrid::Block lifted(multigrid_->size(), 3), solved;
+    const LinearOperator precondition = [&](const Eigen::VectorXd& v, Eigen::VectorXd& out) {
+      out.resize(v.size());
+      tbb::parallel_for(0, np_, [&](int p) {
+        if (interior_row_[p] >= 0) {
+          lifted.row(interior_row_[p]) = lift(v, p).transpose();
+        }
+      });
+      multigrid_->apply(lifted, solved);
+      tbb::parallel_for(0, np_, [&](int p) {
+        if (interior_row_[p] >= 0) {
+          drop(solved.row(interior_row_[p]).transpose(), p, out);
+        }
+      });
+    };
+    ConjugateGradientOptions cg;
+    cg.max_iterations = 60;
+    cg.tolerance = 1e-4;
+    cg_iterations += conjugate_gradient(apply_m, precondition, rhs, delta_, cg).iterations;
+  }
+  std::fill(moving_.begin(), moving_.end(), 0);
+  for (size_t k = 0; k < interior_.size(); ++k) {
+    const int p = interior_[k];
+    targets_[k] = x_[p] + step * basis_[p] * delta_.segment<2>(unknown_[p]);
+    moving_[p] = 1;
+  }
+  project_interior();
+}
+
+// A Newton step moves every particle at once, coherently with its neighbours, so it is accepted
+// or refused as a whole: with all candidates in place, no corner of any face may turn the wrong
+// way or fall below min_corner_sine and below its previous value. The full step, then half and a
+// quarter of it, are tried.
+bool Sampler::newton_step(double& largest) {
+  if (!newton_ready_) {
+    try {
+      prepare_newton();
+    } catch (const NumericalError&) {
+      return false;  // an interior part not tied to the boundary: the sweeps handle it
+    }
+  }
+  std::vector<double> before(np_);
+  tbb::parallel_for(0, np_, [&](int p) { before[p] = min_sine_around(p); });
+  std::vector<SurfacePoint>& sp = grid_.source_points;
+  const std::vector<Eigen::Vector3d> old_x = x_, old_n = normal_;
+  const std::vector<double> old_r = r_;
+  const std::vector<SurfacePoint> old_sp = sp;
+  for (const double step : {1.0, 0.5, 0.25}) {
+    newton_candidates(step);
+    evaluate_candidate_weights();
+    for (int p = 0; p < np_; ++p) {
+      if (moving_[p]) {
+        x_[p] = new_x_[p];
+        sp[p] = new_sp_[p];
+        normal_[p] = new_normal_[p];
+        r_[p] = new_r_[p];
+      }
+    }
+    std::vector<char> bad(np_, 0);
+    tbb::parallel_for(0, np_, [&](int p) {
+      const double after = min_sine_around(p);
+      bad[p] = !(after > 0.0 && (after > options_.min_corner_sine || after >= before[p]));
+    });
+    if (std::find(bad.begin(), bad.end(), 1) == bad.end()) {
+      largest = 0.0;
+      for (int p = 0; p < np_; ++p) {
+        largest = std::max(largest, (x_[p] - old_x[p]).norm());
+        if (moving_[p] && grid_.is_boundary[p]) {
+          s_[loop_index_[p]] = new_s_[p];
+        }
+      }
+      return true;
+    }
+    x_ = old_x;
+    normal_ = old_n;
+    r_ = old_r;
+    sp = old_sp;
+  }
+  return false;
+}
+
+// Write back: positions, boundary parameters, UVs, springs.
+void Sampler::write_back(AdaptiveSamplingResult& result) const {
+  for (int p = 0; p < np_; ++p) {
+    grid_.mesh.point(GridMesh::VertexHandle(p)) = GridMesh::Point(x_[p].x(), x_[p].y(), x_[p].z());
+  }
+  grid_.boundary_parameter = s_;
+  if (!grid_.source_uv.empty()) {
+    const RegionTexcoords texcoords(region_);
+    for (int p = 0; p < np_; ++p) {
+      texcoords.at(grid_.source_points[p], grid_.source_uv[p]);
+    }
+  }
+  grid_.build_springs();
+  double sum = 0.0;
+  for (int p = 0; p < np_; ++p) {
+    sum += r_[p];
+  }
+  result.mean_curvature_weight = np_ > 0 ? sum / np_ : 0.0;
+  result.rejected_moves = rejected;
+  result.cg_iterations = cg_iterations;
+}
+
+}  // namespace
+
+AdaptiveSamplingResult adaptive_sampling(const ParticleGrid& input, const Region& region,
+                                         const SurfaceProjector& projector,
+                                         const AdaptiveSamplingOptions& options) {
+  validate(input, options);
+  AdaptiveSamplingResult result;
+  result.grid = input;
+  Sampler sampler(result.grid, region, projector, options);
+  if (!(sampler.mean_spring_length() > 0.0)) {
+    throw InvalidInputError(options.name, "the particle grid has no springs");
+  }
+  sampler.jitter();
+  sampler.fix_weight_reference();
+
+  bool newton = options.method == SamplingMethod::Newton;
+  for (int it = 0; it < options.max_iterations; ++it) {
+    double largest = 0.0;
+    if (newton && sampler.newton_step(largest)) {
+      ++result.newton_steps;
+    } else {
+      // A refused Newton step (a face would fold) hands over to the guarded sweeps for good.
+      newton = false;
+      sampler.jacobi_candidates();
+      largest = sampler.accept_sequentially();
+    }
     result.iterations = it + 1;
-    result.max_move = largest / spacing;
+    result.max_move = largest / sampler.mean_spring_length();
     result.converged = result.max_move < options.tolerance;
     if (!report_progress(options.progress, Progress{.stage = "adaptive sampling",
                                                     .iteration = it + 1,
@@ -385,25 +612,7 @@ AdaptiveSamplingResult adaptive_sampling(const ParticleGrid& input, const Region
       break;
     }
   }
-
-  // Write back: positions, boundary parameters, UVs, springs.
-  for (int p = 0; p < np; ++p) {
-    grid.mesh.point(GridMesh::VertexHandle(p)) = GridMesh::Point(x[p].x(), x[p].y(), x[p].z());
-  }
-  grid.boundary_parameter = s;
-  if (!grid.source_uv.empty()) {
-    const RegionTexcoords texcoords(region);
-    for (int p = 0; p < np; ++p) {
-      texcoords.at(sp[p], grid.source_uv[p]);
-    }
-  }
-  grid.build_springs();
-  double rbar_end = 0.0;
-  for (int p = 0; p < np; ++p) {
-    rbar_end += r[p];
-  }
-  result.mean_curvature_weight = np > 0 ? rbar_end / np : 0.0;
-  result.rejected_moves = rejected;
+  sampler.write_back(result);
   return result;
 }
 

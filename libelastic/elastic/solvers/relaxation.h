@@ -30,7 +30,7 @@
 #include "elastic/particles/particle_grid.h"
 #include "elastic/particles/spring_energy.h"
 #include "elastic/projection/closest_point.h"
-#include "elastic/solvers/multigrid.h"
+#include "elastic/numerics/multigrid.h"
 #include "elastic/surface/surface_point.h"
 
 namespace elastic {

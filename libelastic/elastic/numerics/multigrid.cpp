@@ -1,4 +1,4 @@
-#include "elastic/solvers/multigrid.h"
+#include "elastic/numerics/multigrid.h"
 
 #include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>

@@ -3,7 +3,7 @@
 // for L^-1 in L-BFGS), contract the error by a grid-independent factor, and be exact when the
 // matrix is small enough to be the coarsest level.
 
-#include "elastic/solvers/multigrid.h"
+#include "elastic/numerics/multigrid.h"
 
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
