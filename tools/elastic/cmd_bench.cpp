@@ -11,6 +11,7 @@
 #include <iostream>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <sstream>
 
 #include "bench_common.h"
@@ -21,6 +22,7 @@
 #include "compare_methods.h"
 #include "elastic/core/atomic_file.h"
 #include "elastic/core/error.h"
+#include "elastic/metrics/map_metrics.h"
 #include "job_file.h"
 #include "map_job.h"
 
@@ -143,33 +145,57 @@ nlohmann::json run_case(const nlohmann::json& c, const BenchArgs& args) {
 const std::vector<std::string> kMethods = {"elastic", "naive", "lscm", "arap", "dcm"};
 const std::vector<std::string> kBaselines = {"naive", "lscm", "arap", "dcm"};
 
+// One table of the page per report key. The perfect value of a per-triangle metric is the
+// library's (perfect_value); the counts, the length energy and seconds are perfect at 0.
 struct MetricColumn {
   std::string key;
-  std::string title;
-  bool lower_is_better_abs = false;  // compare |value - perfect| (e.g. stretch, conformal)
-  double perfect = 0.0;
+  std::string qualifier;                  // after the key in the title ("forward", "particles")
+  std::optional<TriangleMetric> measure;  // the triangle metric the aggregate is of
+  bool timing = false;                    // seconds: no perfect value, no best value
+  std::string note;                       // before the perfect value in the title
+
+  double perfect() const { return measure ? perfect_value(*measure) : 0.0; }
+  // Closeness to perfect: |value - perfect| where perfect is not 0 (a stretch of 0.9 is as far
+  // from perfect as one of 1.1), else the value itself.
+  double score(double value) const {
+    return perfect() != 0.0 ? std::abs(value - perfect()) : value;
+  }
+  std::string title() const {
+    if (timing) return key + " " + qualifier;
+    return key + qualifier + " (" + note + fmt(perfect()) + " is perfect)";
+  }
 };
 const std::vector<MetricColumn> kMetricTables = {
-    {"length_energy", "length_energy (eq. 13 normalised; 0 is perfect)", false, 0.0},
-    {"symmetric_dirichlet", "symmetric_dirichlet (4 is perfect)", true, 4.0},
-    {"angle_error_mean_deg", "angle_error_mean_deg (0 is perfect)", false, 0.0},
-    {"angle_error_max_deg", "angle_error_max_deg (0 is perfect)", false, 0.0},
-    {"stretch_l2", "stretch_l2, forward (1 is perfect)", true, 1.0},
-    {"stretch_linf", "stretch_linf, forward (1 is perfect)", true, 1.0},
-    {"inverse_stretch_l2", "inverse_stretch_l2 (1 is perfect)", true, 1.0},
-    {"inverse_stretch_linf", "inverse_stretch_linf (1 is perfect)", true, 1.0},
-    {"area_distortion", "area_distortion (0 is perfect)", false, 0.0},
-    {"conformal_distortion", "conformal_distortion (1 is perfect)", true, 1.0},
-    {"folds", "folds (0 is perfect)", false, 0.0},
-    {"outside", "outside particles (0 is perfect)", false, 0.0},
-    {"seconds", "seconds on the shared grid", false, 0.0},
+    {"length_energy", "", std::nullopt, false, "eq. 13 normalised; "},
+    {"symmetric_dirichlet", "", TriangleMetric::SymmetricDirichlet, false, ""},
+    {"angle_error_mean_deg", "", TriangleMetric::AngleError, false, ""},
+    {"angle_error_max_deg", "", TriangleMetric::AngleError, false, ""},
+    {"stretch_l2", ", forward", TriangleMetric::StretchL2, false, ""},
+    {"stretch_linf", ", forward", TriangleMetric::StretchLinf, false, ""},
+    {"inverse_stretch_l2", "", TriangleMetric::InverseStretchL2, false, ""},
+    // The largest inverse stretch 1/s2: perfect where the inverse L2 stretch is.
+    {"inverse_stretch_linf", "", TriangleMetric::InverseStretchL2, false, ""},
+    {"area_distortion", "", TriangleMetric::AreaDistortion, false, ""},
+    {"conformal_distortion", "", TriangleMetric::ConformalDistortion, false, ""},
+    {"folds", "", std::nullopt, false, ""},
+    {"outside", " particles", std::nullopt, false, ""},
+    {"seconds", "on the shared grid", std::nullopt, true, ""},
 };
 
 bool has_metric(const nlohmann::json& method, const std::string& key) {
   return method.contains(key) && method[key].is_number();
 }
 
-std::string results_markdown(const nlohmann::json& report) {
+// The page's prose (what the methods are, what the bar is) lives in the cases file beside the cases
+// it describes ("page": {"methods": ..., "bar": ...}); a cases file without it gets the tables
+// alone.
+std::string page_text(const nlohmann::json& cases_file, const char* key) {
+  if (!cases_file.contains("page") || !cases_file["page"].is_object()) return "";
+  const nlohmann::json& page = cases_file["page"];
+  return page.contains(key) && page[key].is_string() ? page[key].get<std::string>() : "";
+}
+
+std::string results_markdown(const nlohmann::json& report, const nlohmann::json& cases_file) {
   std::ostringstream s;
   const nlohmann::json& cases = report["cases"];
   const nlohmann::json& machine = report["machine"];
@@ -179,13 +205,9 @@ std::string results_markdown(const nlohmann::json& report) {
     << machine["threads"] << " hardware threads, "
     << "solver threads " << machine["solver_threads"] << ", median of " << report["runs"]
     << " runs. Raw numbers: [results/table1.json](results/table1.json). Cases, regions and why: "
-       "`tools/benchmarks/table1_cases.json`. Metric definitions: [metrics.md](metrics.md).\n\n"
-    << "Every method is measured on ElasticPaint's particle grid with the same boundary "
-       "correspondence (arc length from the anchors): `elastic` is ElasticPaint (L-BFGS), `naive` "
-       "its starting map (composed disk maps), `lscm`, `arap`, `dcm` the two-flattening baselines "
-       "(docs/baselines.md). Seconds: the case's `seconds` is the whole map (sampling, naive map, "
-       "relaxation, mapping; files loaded beforehand); a method's seconds are its own work on the "
-       "shared grid. The paper's seconds are from a 1.4 GHz Pentium 4 (2002).\n\n";
+       "`tools/benchmarks/table1_cases.json`. Metric definitions: [metrics.md](metrics.md).\n\n";
+  const std::string methods_text = page_text(cases_file, "methods");
+  if (!methods_text.empty()) s << methods_text << "\n\n";
 
   s << "## Table 1\n\n"
     << "| source → target | particles (paper) | springs (paper) | seconds | paper seconds | "
@@ -209,7 +231,7 @@ std::string results_markdown(const nlohmann::json& report) {
 
   s << "\n## Every metric, every method\n\nBold: the best value of the row (closest to perfect).\n";
   for (const MetricColumn& col : kMetricTables) {
-    s << "\n### " << col.title << "\n\n| case |";
+    s << "\n### " << col.title() << "\n\n| case |";
     for (const auto& m : kMethods) s << ' ' << m << " |";
     s << "\n|---|";
     for (size_t k = 0; k < kMethods.size(); ++k) s << "---:|";
@@ -221,7 +243,7 @@ std::string results_markdown(const nlohmann::json& report) {
       for (const auto& m : kMethods) {
         if (methods.contains(m) && has_metric(methods[m], col.key)) {
           const double v = methods[m][col.key].get<double>();
-          best = std::min(best, col.lower_is_better_abs ? std::abs(v - col.perfect) : v);
+          best = std::min(best, col.score(v));
         }
       }
       s << "| " << c["name"].get<std::string>() << " |";
@@ -231,14 +253,14 @@ std::string results_markdown(const nlohmann::json& report) {
           continue;
         }
         const double v = methods[m][col.key].get<double>();
-        const double score = col.lower_is_better_abs ? std::abs(v - col.perfect) : v;
         const std::string text = fmt(v);
-        s << ' ' << (score == best && col.key != "seconds" ? "**" + text + "**" : text) << " |";
+        s << ' ' << (col.score(v) == best && !col.timing ? "**" + text + "**" : text) << " |";
       }
       s << '\n';
     }
   }
 
+  const double sd_perfect = perfect_value(TriangleMetric::SymmetricDirichlet);
   s << "\n## Against LSCM\n\nRatios elastic / lscm (below 1: ElasticPaint is better) and the "
        "folds and outside particles of both.\n\n"
     << "| case | length_energy ratio | symmetric_dirichlet − 4 ratio | angle_error_mean ratio | "
@@ -254,16 +276,16 @@ std::string results_markdown(const nlohmann::json& report) {
     }
     const auto ratio = [](double a, double b) { return b > 0.0 ? fmt(a / b, 3) : "–"; };
     s << ratio(e["length_energy"].get<double>(), l["length_energy"].get<double>()) << " | "
-      << ratio(e["symmetric_dirichlet"].get<double>() - 4.0,
-               l["symmetric_dirichlet"].get<double>() - 4.0)
+      << ratio(e["symmetric_dirichlet"].get<double>() - sd_perfect,
+               l["symmetric_dirichlet"].get<double>() - sd_perfect)
       << " | "
       << ratio(e["angle_error_mean_deg"].get<double>(), l["angle_error_mean_deg"].get<double>())
       << " | " << e["folds"] << " / " << l["folds"] << " | " << l["outside"] << " |\n";
   }
 
-  s << "\n## The bar (issue 5)\n\nElasticPaint has zero folds, and its length_energy and "
-       "symmetric_dirichlet are at most those of the best of the other methods (naive, lscm, "
-       "arap, dcm) on the same grid.\n\n"
+  const std::string bar_text = page_text(cases_file, "bar");
+  s << "\n## The bar (issue 5)\n\n"
+    << (bar_text.empty() ? "" : bar_text + "\n\n")
     << "| case | folds | length_energy: elastic / best other | symmetric_dirichlet: elastic / "
        "best other | verdict |\n|---|---:|---|---|---|\n";
   for (const auto& c : cases) {
@@ -326,7 +348,7 @@ int run_bench(const BenchArgs& args, const CLI::App& sub) {
     }
   }
   write_report(args.report, report);
-  const std::string page = results_markdown(report);
+  const std::string page = results_markdown(report, cases_file);
   if (!args.markdown.empty()) {
     write_file_atomically(args.markdown, [&](std::ofstream& out) { out << page; });
   } else {

@@ -4,11 +4,15 @@
 /// a mesh name) and says what is wrong with it, so that a tool can print `what()` as one line for
 /// the user.
 ///
+// clang-format off
 ///   Error                    base of everything the library throws on purpose
-///   ├── IoError              a file cannot be opened, read or written (missing, permission, disk
-///   full) ├── InvalidInputError    the input is readable but wrong: malformed file, non-manifold
-///   mesh, │                        NaN coordinates, a curve off the surface, an absurd count, ...
-///   └── NumericalError       a computation failed on valid input (no convergence, singular system)
+///   ├── IoError              a file cannot be opened, read or written (missing, permission,
+///   │                        disk full)
+///   ├── InvalidInputError    the input is readable but wrong: malformed file, non-manifold
+///   │                        mesh, NaN coordinates, a curve off the surface, an absurd count, ...
+///   └── NumericalError       a computation failed on valid input (no convergence, singular
+///                            system)
+// clang-format on
 ///
 /// `what()` is "<input>: <problem>"; `input()` and `problem()` give the two parts.
 

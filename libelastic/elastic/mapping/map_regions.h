@@ -93,9 +93,8 @@ struct MapResult {
 
 /// Maps `source_region` (on `source`) onto `target_region` (on `target`).
 /// The regions must lie on the projectors' surfaces and outlive the result, as must the projectors.
-/// \throws InvalidInputError for inconsistent inputs or options (naming them); NumericalError when
-/// a
-///         stage fails numerically.
+/// \throws InvalidInputError for inconsistent inputs or options (naming them); NumericalError
+///         when a stage fails numerically.
 MapResult map_regions(const SurfaceProjector& source, const Region& source_region,
                       const SurfaceProjector& target, const Region& target_region,
                       const MapOptions& options = {});

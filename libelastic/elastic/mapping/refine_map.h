@@ -9,14 +9,14 @@
 ///    (RegionDiskMap::from_disk), new boundary particles on the source curve at the mid-parameter
 ///    of their neighbours (RegionDiskMap::boundary_point for their SurfacePoint).
 /// 2. Target placement: an old particle keeps its relaxed target point. A new boundary particle
-/// goes
-///    to the target curve at its correspondence parameter s, exactly as the naive map puts boundary
-///    particles there (RegionDiskMap::boundary_point of the target region, at its limit position),
-///    so the boundary correspondence stays the arc-length one of §4.1. A new interior particle goes
-///    to the magnet (closest target point) of the average of its parents' relaxed target positions
-///    (edge: midpoint, quad: centroid), warm-started at its first parent's target point. On a
-///    fold-free map this start is fold-free: the sub-faces of a convex quad or a triangle around
-///    its centroid and edge midpoints are convex, up to the surface's curvature over a cell.
+///    goes to the target curve at its correspondence parameter s, exactly as the naive map puts
+///    boundary particles there (RegionDiskMap::boundary_point of the target region, at its limit
+///    position), so the boundary correspondence stays the arc-length one of §4.1. A new interior
+///    particle goes to the magnet (closest target point) of the average of its parents' relaxed
+///    target positions (edge: midpoint, quad: centroid), warm-started at its first parent's target
+///    point. On a fold-free map this start is fold-free: the sub-faces of a convex quad or a
+///    triangle around its centroid and edge midpoints are convex, up to the surface's curvature
+///    over a cell.
 /// 3. The refined grid relaxes briefly on the target with the same energies, rest scale and
 ///    tolerances, the fast solver and a small iteration budget (the start is already close to the
 ///    refined grid's minimum: it differs from it by the coarse grid's discretisation error).

@@ -34,6 +34,30 @@ class DisjointSets {
   std::vector<int> parent_;
 };
 
+/// Components, the one definition: faces joined through shared vertices (the union of every
+/// face's corners). Per face the union-find root of its component, -1 for the faces `face_ok`
+/// leaves out (empty: none).
+std::vector<int> face_components(const PolygonMesh& mesh, const std::vector<char>& face_ok) {
+  const int nf = mesh.num_faces();
+  auto counted = [&](int f) { return face_ok.empty() || face_ok[static_cast<size_t>(f)]; };
+  DisjointSets sets(mesh.num_vertices());
+  for (int f = 0; f < nf; ++f) {
+    if (counted(f)) {
+      const auto face = mesh.face(f);
+      for (size_t k = 1; k < face.size(); ++k) {
+        sets.unite(face[0], face[k]);
+      }
+    }
+  }
+  std::vector<int> root(static_cast<size_t>(nf), -1);
+  for (int f = 0; f < nf; ++f) {
+    if (counted(f)) {
+      root[static_cast<size_t>(f)] = sets.find(mesh.face(f)[0]);
+    }
+  }
+  return root;
+}
+
 void note(IndexFindings& findings, int index, int max_examples) {
   if (findings.count++ < max_examples) {
     findings.examples.push_back(index);
@@ -271,6 +295,121 @@ std::vector<std::string> MeshValidation::describe() const {
   return lines;
 }
 
+namespace {
+
+// Non-manifold and inconsistent edges, boundary edges, and boundary loops (the connected pieces of
+// the graph of boundary edges).
+void note_edge_findings(const EdgeTable& table, int nv, int max_examples, MeshValidation& result) {
+  DisjointSets boundary(nv);
+  for (size_t e = 0; e < table.edges.size(); ++e) {
+    const auto uses = table.uses(e);
+    const auto [a, b] = table.edges[e];
+    if (uses.size() == 1) {
+      ++result.num_boundary_edges;
+      boundary.unite(a, b);
+    } else if (uses.size() > 2) {
+      note(result.non_manifold_edges, a, b, max_examples);
+    } else if (uses[0].forward == uses[1].forward) {
+      note(result.inconsistent_edges, a, b, max_examples);
+    }
+  }
+  {
+    std::vector<char> root_seen(static_cast<size_t>(nv), 0);
+    for (size_t e = 0; e < table.edges.size(); ++e) {
+      if (table.uses(e).size() != 1) {
+        continue;
+      }
+      const int r = boundary.find(table.edges[e].first);
+      if (!root_seen[static_cast<size_t>(r)]) {
+        root_seen[static_cast<size_t>(r)] = 1;
+        ++result.num_boundary_loops;
+      }
+    }
+  }
+}
+
+void count_components(const PolygonMesh& mesh, const std::vector<char>& face_ok,
+                      MeshValidation& result) {
+  // Components: faces joined through shared vertices, i.e. union the corners of every face.
+  {
+    std::unordered_map<int, int> faces_per_root;
+    for (int root : face_components(mesh, face_ok)) {
+      if (root >= 0) {
+        ++faces_per_root[root];
+      }
+    }
+    result.num_components = static_cast<int>(faces_per_root.size());
+    for (const auto& [root, count] : faces_per_root) {
+      result.component_faces.push_back(count);
+    }
+    std::sort(result.component_faces.begin(), result.component_faces.end(), std::greater<>());
+  }
+}
+
+void note_non_manifold_vertices(const PolygonMesh& mesh, const std::vector<char>& face_ok,
+                                const EdgeTable& table, int max_examples, MeshValidation& result) {
+  const int nv = mesh.num_vertices();
+  const int nf = mesh.num_faces();
+  // Non-manifold vertices: around each vertex, join the faces that share an edge at the vertex and
+  // count the groups. Each edge (v, w) joins all faces using it in the per-vertex sets of v and of
+  // w; a vertex-local union-find over "face slots" (vertex, incident face) does this in one pass.
+  {
+    // Incident faces of every vertex, each face listed once per vertex (CSR): one pass counts,
+    // the second fills.
+    std::vector<int> last_face(static_cast<size_t>(nv), -1);
+    auto for_each_incidence = [&](auto&& visit) {
+      std::fill(last_face.begin(), last_face.end(), -1);
+      for (int f = 0; f < nf; ++f) {
+        if (!face_ok[static_cast<size_t>(f)]) {
+          continue;
+        }
+        for (int v : mesh.face(f)) {
+          if (last_face[static_cast<size_t>(v)] != f) {
+            last_face[static_cast<size_t>(v)] = f;
+            visit(v, f);
+          }
+        }
+      }
+    };
+    std::vector<int> start(static_cast<size_t>(nv) + 1, 0);
+    for_each_incidence([&](int v, int) { ++start[static_cast<size_t>(v) + 1]; });
+    for (int v = 0; v < nv; ++v) {
+      start[static_cast<size_t>(v) + 1] += start[static_cast<size_t>(v)];
+    }
+    std::vector<int> incident(static_cast<size_t>(start.back()));
+    std::vector<int> fill(start.begin(), start.end() - 1);
+    for_each_incidence(
+        [&](int v, int f) { incident[static_cast<size_t>(fill[static_cast<size_t>(v)]++)] = f; });
+    // Slot of face f at vertex v: its position in v's (ascending) incident list.
+    auto slot = [&](int v, int f) {
+      const auto begin = incident.begin() + start[static_cast<size_t>(v)];
+      const auto end = incident.begin() + start[static_cast<size_t>(v) + 1];
+      return static_cast<int>(std::lower_bound(begin, end, f) - incident.begin());
+    };
+    DisjointSets fans(static_cast<int>(incident.size()));
+    for (size_t e = 0; e < table.edges.size(); ++e) {
+      const auto uses = table.uses(e);
+      for (size_t i = 1; i < uses.size(); ++i) {
+        for (int v : {table.edges[e].first, table.edges[e].second}) {
+          fans.unite(slot(v, uses[0].face), slot(v, uses[i].face));
+        }
+      }
+    }
+    for (int v = 0; v < nv; ++v) {
+      const int b = start[static_cast<size_t>(v)];
+      const int e = start[static_cast<size_t>(v) + 1];
+      for (int s = b + 1; s < e; ++s) {
+        if (fans.find(s) != fans.find(b)) {
+          note(result.non_manifold_vertices, v, max_examples);
+          break;
+        }
+      }
+    }
+  }
+}
+
+}  // namespace
+
 MeshValidation validate_mesh(const PolygonMesh& mesh, const ValidationOptions& options) {
   const int max_examples = std::max(0, options.max_examples);
   MeshValidation result;
@@ -323,119 +462,9 @@ MeshValidation validate_mesh(const PolygonMesh& mesh, const ValidationOptions& o
 
   const EdgeTable table = build_edges(mesh, face_ok);
   result.num_edges = static_cast<int>(table.edges.size());
-  DisjointSets boundary(nv);
-  for (size_t e = 0; e < table.edges.size(); ++e) {
-    const auto uses = table.uses(e);
-    const auto [a, b] = table.edges[e];
-    if (uses.size() == 1) {
-      ++result.num_boundary_edges;
-      boundary.unite(a, b);
-    } else if (uses.size() > 2) {
-      note(result.non_manifold_edges, a, b, max_examples);
-    } else if (uses[0].forward == uses[1].forward) {
-      note(result.inconsistent_edges, a, b, max_examples);
-    }
-  }
-  {
-    std::vector<char> root_seen(static_cast<size_t>(nv), 0);
-    for (size_t e = 0; e < table.edges.size(); ++e) {
-      if (table.uses(e).size() != 1) {
-        continue;
-      }
-      const int r = boundary.find(table.edges[e].first);
-      if (!root_seen[static_cast<size_t>(r)]) {
-        root_seen[static_cast<size_t>(r)] = 1;
-        ++result.num_boundary_loops;
-      }
-    }
-  }
-
-  // Components: faces joined through shared vertices, i.e. union the corners of every face.
-  {
-    DisjointSets sets(nv);
-    for (int f = 0; f < nf; ++f) {
-      if (!face_ok[static_cast<size_t>(f)]) {
-        continue;
-      }
-      const auto face = mesh.face(f);
-      for (size_t k = 1; k < face.size(); ++k) {
-        sets.unite(face[0], face[k]);
-      }
-    }
-    std::unordered_map<int, int> faces_per_root;
-    for (int f = 0; f < nf; ++f) {
-      if (face_ok[static_cast<size_t>(f)]) {
-        ++faces_per_root[sets.find(mesh.face(f)[0])];
-      }
-    }
-    result.num_components = static_cast<int>(faces_per_root.size());
-    for (const auto& [root, count] : faces_per_root) {
-      result.component_faces.push_back(count);
-    }
-    std::sort(result.component_faces.begin(), result.component_faces.end(), std::greater<>());
-  }
-
-  // Non-manifold vertices: around each vertex, join the faces that share an edge at the vertex and
-  // count the groups. Each edge (v, w) joins all faces using it in the per-vertex sets of v and of
-  // w; a vertex-local union-find over "face slots" (vertex, incident face) does this in one pass.
-  {
-    // Incident faces of every vertex, each face listed once per vertex (CSR).
-    std::vector<int> start(static_cast<size_t>(nv) + 1, 0);
-    std::vector<int> last_face(static_cast<size_t>(nv), -1);
-    for (int f = 0; f < nf; ++f) {
-      if (!face_ok[static_cast<size_t>(f)]) {
-        continue;
-      }
-      for (int v : mesh.face(f)) {
-        if (last_face[static_cast<size_t>(v)] != f) {
-          last_face[static_cast<size_t>(v)] = f;
-          ++start[static_cast<size_t>(v) + 1];
-        }
-      }
-    }
-    for (int v = 0; v < nv; ++v) {
-      start[static_cast<size_t>(v) + 1] += start[static_cast<size_t>(v)];
-    }
-    std::vector<int> incident(static_cast<size_t>(start.back()));
-    std::vector<int> fill(start.begin(), start.end() - 1);
-    std::fill(last_face.begin(), last_face.end(), -1);
-    for (int f = 0; f < nf; ++f) {
-      if (!face_ok[static_cast<size_t>(f)]) {
-        continue;
-      }
-      for (int v : mesh.face(f)) {
-        if (last_face[static_cast<size_t>(v)] != f) {
-          last_face[static_cast<size_t>(v)] = f;
-          incident[static_cast<size_t>(fill[static_cast<size_t>(v)]++)] = f;
-        }
-      }
-    }
-    // Slot of face f at vertex v: its position in v's (ascending) incident list.
-    auto slot = [&](int v, int f) {
-      const auto begin = incident.begin() + start[static_cast<size_t>(v)];
-      const auto end = incident.begin() + start[static_cast<size_t>(v) + 1];
-      return static_cast<int>(std::lower_bound(begin, end, f) - incident.begin());
-    };
-    DisjointSets fans(static_cast<int>(incident.size()));
-    for (size_t e = 0; e < table.edges.size(); ++e) {
-      const auto uses = table.uses(e);
-      for (size_t i = 1; i < uses.size(); ++i) {
-        for (int v : {table.edges[e].first, table.edges[e].second}) {
-          fans.unite(slot(v, uses[0].face), slot(v, uses[i].face));
-        }
-      }
-    }
-    for (int v = 0; v < nv; ++v) {
-      const int b = start[static_cast<size_t>(v)];
-      const int e = start[static_cast<size_t>(v) + 1];
-      for (int s = b + 1; s < e; ++s) {
-        if (fans.find(s) != fans.find(b)) {
-          note(result.non_manifold_vertices, v, max_examples);
-          break;
-        }
-      }
-    }
-  }
+  note_edge_findings(table, nv, max_examples, result);
+  count_components(mesh, face_ok, result);
+  note_non_manifold_vertices(mesh, face_ok, table, max_examples, result);
 
   if (result.non_manifold_edges.count == 0) {
     std::vector<char> flip;
@@ -566,6 +595,40 @@ bool has_repeated_index(const PolygonMesh& mesh, int f, std::vector<int>& scratc
 
 }  // namespace
 
+namespace {
+
+/// Keeps the component with the most faces (ties: the one with the lowest face index).
+void keep_largest_component(PolygonMesh& mesh, RepairResult& result) {
+  const std::vector<int> component = face_components(mesh, {});
+  std::unordered_map<int, int> count;
+  std::unordered_map<int, int> first_face;
+  for (int f = 0; f < mesh.num_faces(); ++f) {
+    const int r = component[static_cast<size_t>(f)];
+    ++count[r];
+    first_face.try_emplace(r, f);
+  }
+  int best = -1;
+  for (const auto& [root, n] : count) {
+    if (best < 0 || n > count[best] || (n == count[best] && first_face[root] < first_face[best])) {
+      best = root;
+    }
+  }
+  if (count.size() > 1) {
+    std::vector<char> keep(static_cast<size_t>(mesh.num_faces()));
+    for (int f = 0; f < mesh.num_faces(); ++f) {
+      keep[static_cast<size_t>(f)] = component[static_cast<size_t>(f)] == best ? 1 : 0;
+    }
+    result.removed_components = static_cast<int>(count.size()) - 1;
+    result.removed_component_faces = mesh.num_faces() - count[best];
+    keep_faces(mesh, keep);
+    result.actions.push_back("kept the largest of " + std::to_string(count.size()) +
+                             " components, removing " +
+                             std::to_string(result.removed_component_faces) + " faces");
+  }
+}
+
+}  // namespace
+
 RepairResult repair_mesh(PolygonMesh& mesh, const RepairOptions& options) {
   RepairResult result;
   const MeshValidation before = validate_mesh(mesh, options.validation);
@@ -602,39 +665,7 @@ RepairResult repair_mesh(PolygonMesh& mesh, const RepairOptions& options) {
   }
 
   if (options.keep_largest_component && mesh.num_faces() > 0) {
-    DisjointSets sets(mesh.num_vertices());
-    for (int f = 0; f < mesh.num_faces(); ++f) {
-      const auto face = mesh.face(f);
-      for (size_t k = 1; k < face.size(); ++k) {
-        sets.unite(face[0], face[k]);
-      }
-    }
-    std::unordered_map<int, int> count;
-    std::unordered_map<int, int> first_face;
-    for (int f = 0; f < mesh.num_faces(); ++f) {
-      const int r = sets.find(mesh.face(f)[0]);
-      ++count[r];
-      first_face.try_emplace(r, f);
-    }
-    int best = -1;
-    for (const auto& [root, n] : count) {
-      if (best < 0 || n > count[best] ||
-          (n == count[best] && first_face[root] < first_face[best])) {
-        best = root;
-      }
-    }
-    if (count.size() > 1) {
-      std::vector<char> keep(static_cast<size_t>(mesh.num_faces()));
-      for (int f = 0; f < mesh.num_faces(); ++f) {
-        keep[static_cast<size_t>(f)] = sets.find(mesh.face(f)[0]) == best ? 1 : 0;
-      }
-      result.removed_components = static_cast<int>(count.size()) - 1;
-      result.removed_component_faces = mesh.num_faces() - count[best];
-      keep_faces(mesh, keep);
-      result.actions.push_back("kept the largest of " + std::to_string(count.size()) +
-                               " components, removing " +
-                               std::to_string(result.removed_component_faces) + " faces");
-    }
+    keep_largest_component(mesh, result);
   }
 
   if (options.fix_winding) {
@@ -677,50 +708,84 @@ RepairResult repair_mesh(PolygonMesh& mesh, const RepairOptions& options) {
   return result;
 }
 
-void require_valid_manifold(const PolygonMesh& mesh, const std::string& name,
-                            const ManifoldRequirements& requirements) {
-  const MeshValidation v = validate_mesh(mesh, requirements.validation);
-  auto fail = [&](const std::string& problem) { throw InvalidInputError(name, problem); };
-  if (mesh.num_faces() == 0) {
-    fail("the mesh has no faces");
+namespace {
+
+// The first malformed face with its defect, e.g. "face 3 refers to vertex 42, which does not
+// exist".
+std::string malformed_example(const PolygonMesh& mesh, const IndexFindings& malformed) {
+  if (malformed.examples.empty()) {
+    return "";
+  }
+  const int f = malformed.examples.front();
+  if (mesh.face_size(f) < 3) {
+    return "; face " + std::to_string(f) + " has fewer than 3 corners";
+  }
+  for (int v : mesh.face(f)) {
+    if (v < 0 || v >= mesh.num_vertices()) {
+      return "; face " + std::to_string(f) + " refers to vertex " + std::to_string(v) +
+             ", which does not exist";
+    }
+  }
+  return "";
+}
+
+}  // namespace
+
+std::string manifold_problem(const PolygonMesh& mesh, const MeshValidation& v,
+                             const ManifoldRequirements& requirements) {
+  if (!requirements.allow_no_faces && mesh.num_faces() == 0) {
+    return "the mesh is empty (no faces)";
   }
   if (v.malformed_faces.count) {
-    fail(finding_text(v.malformed_faces,
-                      "malformed faces (< 3 corners or vertex index out of range)"));
+    return finding_text(v.malformed_faces,
+                        "malformed faces (< 3 corners or vertex index out of range)") +
+           malformed_example(mesh, v.malformed_faces);
   }
   if (v.non_finite_vertices.count) {
-    fail(finding_text(v.non_finite_vertices, "vertices with NaN or infinite coordinates"));
+    return finding_text(v.non_finite_vertices,
+                        "vertices with a non-finite (NaN or infinite) coordinate");
   }
   if (v.non_manifold_edges.count) {
-    fail(finding_text(v.non_manifold_edges, "non-manifold edges (used by more than two faces)"));
+    return finding_text(v.non_manifold_edges, "non-manifold edges (used by more than two faces)");
   }
   if (v.non_manifold_vertices.count) {
-    fail(finding_text(v.non_manifold_vertices,
-                      "non-manifold vertices (the faces around them form no single fan)"));
+    return finding_text(v.non_manifold_vertices,
+                        "non-manifold vertices (the faces around them form no single fan)");
   }
   if (v.repeated_index_faces.count) {
-    fail(finding_text(v.repeated_index_faces, "faces with a repeated vertex index") +
-         " (repair_mesh removes them)");
+    return finding_text(v.repeated_index_faces, "faces with a repeated vertex index") +
+           " (repair_mesh removes them)";
   }
   if (v.inconsistent_edges.count) {
-    fail(
-        finding_text(v.inconsistent_edges, "edges whose two faces disagree in orientation") +
-        (v.orientable ? " (repair_mesh flips faces to fix this)" : "; the mesh is not orientable"));
+    return finding_text(v.inconsistent_edges, "edges whose two faces disagree in orientation") +
+           (v.orientable ? " (repair_mesh flips faces to fix this)"
+                         : "; the mesh is not orientable");
   }
   if (!requirements.allow_zero_area_faces && v.zero_area_faces.count) {
-    fail(finding_text(v.zero_area_faces, "zero-area faces") + " (repair_mesh removes them)");
+    return finding_text(v.zero_area_faces, "zero-area faces") + " (repair_mesh removes them)";
   }
   if (!requirements.allow_several_components && v.num_components > 1) {
-    fail(std::to_string(v.num_components) +
-         " connected components where one is required (repair_mesh can keep the largest)");
+    return std::to_string(v.num_components) +
+           " connected components where one is required (repair_mesh can keep the largest)";
   }
   if (!requirements.allow_boundary && v.num_boundary_edges > 0) {
-    fail(std::to_string(v.num_boundary_loops) + " boundary loops (" +
-         std::to_string(v.num_boundary_edges) + " boundary edges) where a closed mesh is required");
+    return std::to_string(v.num_boundary_loops) + " boundary loops (" +
+           std::to_string(v.num_boundary_edges) +
+           " boundary edges) where a closed mesh is required";
   }
-  if (v.unreferenced_vertices.count) {
-    fail(finding_text(v.unreferenced_vertices, "unreferenced vertices") +
-         " (repair_mesh removes them)");
+  if (!requirements.allow_unreferenced_vertices && v.unreferenced_vertices.count) {
+    return finding_text(v.unreferenced_vertices, "unreferenced vertices") +
+           " (repair_mesh removes them)";
+  }
+  return "";
+}
+
+void require_valid_manifold(const PolygonMesh& mesh, const std::string& name,
+                            const ManifoldRequirements& requirements) {
+  const std::string problem =
+      manifold_problem(mesh, validate_mesh(mesh, requirements.validation), requirements);
+  if (!problem.empty()) {
+    throw InvalidInputError(name, problem);
   }
 }
 

@@ -5,38 +5,39 @@
 ///
 /// Definitions (they match the independent checker that produced shared/meshes/README.md):
 /// - An *edge* is an unordered vertex pair {a, b}, a != b, that appears as consecutive corners of a
-/// face.
-///   A corner pair (a, a) of a face with a repeated index is no edge.
+///   face. A corner pair (a, a) of a face with a repeated index is no edge.
 /// - A *non-manifold edge* is used by more than two faces.
 /// - An *inconsistent edge* is used by exactly two faces that traverse it in the same direction:
-/// the two
-///   faces disagree about the orientation. (Halfedge structures cannot hold it either, but unlike a
-///   non-manifold edge it can be repaired by flipping faces.)
+///   the two faces disagree about the orientation. (Halfedge structures cannot hold it either, but
+///   unlike a non-manifold edge it can be repaired by flipping faces.)
 /// - A *non-manifold vertex*: the faces around it do not form one fan, i.e. they fall into more
-/// than one
-///   group when faces sharing an edge at the vertex are joined (any shared edge joins, also
-///   non-manifold ones, so a vertex on a non-manifold edge is not counted for that reason alone).
-///   Two cones touching at their tips, or two boundary loops meeting at a vertex, make it one.
+///   than one group when faces sharing an edge at the vertex are joined (any shared edge joins,
+///   also non-manifold ones, so a vertex on a non-manifold edge is not counted for that reason
+///   alone). Two cones touching at their tips, or two boundary loops meeting at a vertex, make it
+///   one.
 /// - *Components* are the groups of faces connected through shared vertices.
 /// - *Boundary edges* are used by exactly one face; *boundary loops* are the connected pieces of
-/// the graph
-///   of boundary edges.
+///   the graph of boundary edges.
 /// - Euler characteristic chi = V - E + F over referenced vertices; for an oriented manifold with
 ///   C components and b boundary loops the total genus is g = (2C - b - chi) / 2.
 ///
 /// Policy (what a tool does with each finding; `sanitize_mesh()` implements it,
-/// docs/file-formats.md repeats it):
+/// docs/file-formats.md repeats it). The wording of every error is `manifold_problem()`'s, which
+/// `require_valid_manifold()`, `to_openmesh()` and `LimitSurface` share.
 ///
-/// | finding                                   | policy |
-/// |-------------------------------------------|------------------------------------------------------|
-/// | unreferenced vertices                     | warning, removed | | faces with a repeated vertex
-/// index        | warning, removed                                     | | zero-area faces |
-/// warning, removed                                     | | several components | error, unless
-/// `keep_largest_component` (warning)     | | inconsistent winding, orientable          | warning,
-/// faces flipped (the majority wins)           | | inconsistent winding, not orientable      |
-/// error                                                | | non-manifold edges / vertices | error |
-/// | malformed faces (< 3 corners, bad index)  | error (readers already reject them) | | NaN /
-/// infinite coordinates                | error (in the reader and here)                       |
+// clang-format off
+/// | finding                                  | policy                                         |
+/// |------------------------------------------|------------------------------------------------|
+/// | unreferenced vertices                    | warning, removed                               |
+/// | faces with a repeated vertex index       | warning, removed                               |
+/// | zero-area faces                          | warning, removed                               |
+/// | several components                       | error, unless `keep_largest_component` (warning) |
+/// | inconsistent winding, orientable         | warning, faces flipped (the majority wins)     |
+/// | inconsistent winding, not orientable     | error                                          |
+/// | non-manifold edges / vertices            | error                                          |
+/// | malformed faces (< 3 corners, bad index) | error (readers already reject them)            |
+/// | NaN / infinite coordinates               | error (in the reader and here)                 |
+// clang-format on
 
 #include <string>
 #include <utility>
@@ -145,7 +146,8 @@ struct RepairResult {
 /// then).
 RepairResult repair_mesh(PolygonMesh& mesh, const RepairOptions& options = {});
 
-/// What a consumer of the mesh demands of it.
+/// What a consumer of the mesh demands of it. The defaults are the tools' policy (the table above);
+/// the halfedge adapter and the limit surface relax what they can represent.
 struct ManifoldRequirements {
   /// Accept meshes with boundary edges.
   bool allow_boundary = true;
@@ -153,14 +155,27 @@ struct ManifoldRequirements {
   bool allow_several_components = false;
   /// Accept zero-area faces (a limit surface tolerates them, a parameterisation may not).
   bool allow_zero_area_faces = false;
+  /// Accept vertices no face uses (a halfedge mesh and a limit surface carry them along).
+  bool allow_unreferenced_vertices = false;
+  /// Accept a mesh without faces (an empty halfedge mesh is a valid one).
+  bool allow_no_faces = false;
   ValidationOptions validation;
 };
 
+/// The manifold policy in words, the one wording every consumer uses: the first problem of `mesh`
+/// (validated as `validation`) that `requirements` does not accept, or "" when there is none. An
+/// oriented manifold is required always: no malformed faces (the first one is named with its
+/// defect), no non-finite coordinates, no non-manifold edges or vertices, no faces with a repeated
+/// vertex, consistent winding. The text names the offending indices and says when repair_mesh()
+/// would fix the problem; it does not name the mesh (callers put it in front, as InvalidInputError
+/// does).
+std::string manifold_problem(const PolygonMesh& mesh, const MeshValidation& validation,
+                             const ManifoldRequirements& requirements = {});
+
 /// Throws unless the mesh is an oriented manifold meeting `requirements`, with no unreferenced or
-/// non-finite vertices.
-/// \throws InvalidInputError "<name>: <first problem>", the problem naming the offending indices
-/// and, when
-///         repair_mesh() would fix it, saying so.
+/// non-finite vertices: manifold_problem() of validate_mesh(mesh).
+/// \throws InvalidInputError "<name>: <first problem>", the problem naming the offending
+///         indices and, when repair_mesh() would fix it, saying so.
 void require_valid_manifold(const PolygonMesh& mesh, const std::string& name,
                             const ManifoldRequirements& requirements = {});
 

@@ -7,7 +7,6 @@
 #include "elastic/mesh/openmesh_adapter.h"
 
 #include <map>
-#include <type_traits>
 
 #include "elastic/core/error.h"
 #include "elastic/mesh/mesh_validation.h"
@@ -16,52 +15,18 @@ namespace elastic {
 
 HalfedgeMesh to_openmesh(const PolygonMesh& mesh, const ToOpenMeshOptions& options) {
   // Refuse up front what OpenMesh's add_face cannot represent: it would print and drop the face.
-  // Unreferenced vertices, zero-area faces and several components are representable and accepted.
-  ValidationOptions validation;
-  validation.max_examples = 5;
-  const MeshValidation v = validate_mesh(mesh, validation);
-  auto refuse = [&](const char* what, int count, const std::string& examples) {
-    throw InvalidInputError(options.name, "cannot build a halfedge mesh: " + std::to_string(count) +
-                                              " " + what + ", e.g." + examples);
-  };
-  auto list = [](const auto& examples) {
-    std::string s;
-    for (const auto& e : examples) {
-      if constexpr (std::is_same_v<std::decay_t<decltype(e)>, int>) {
-        s += ' ';
-        s += std::to_string(e);
-      } else {
-        s += " (";
-        s += std::to_string(e.first);
-        s += ", ";
-        s += std::to_string(e.second);
-        s += ')';
-      }
-    }
-    return s;
-  };
-  if (v.malformed_faces.count) {
-    refuse("malformed faces", v.malformed_faces.count, list(v.malformed_faces.examples));
-  }
-  if (v.non_finite_vertices.count) {
-    refuse("vertices with NaN or infinite coordinates", v.non_finite_vertices.count,
-           list(v.non_finite_vertices.examples));
-  }
-  if (v.non_manifold_edges.count) {
-    refuse("non-manifold edges (used by more than two faces)", v.non_manifold_edges.count,
-           list(v.non_manifold_edges.examples));
-  }
-  if (v.non_manifold_vertices.count) {
-    refuse("non-manifold vertices", v.non_manifold_vertices.count,
-           list(v.non_manifold_vertices.examples));
-  }
-  if (v.repeated_index_faces.count) {
-    refuse("faces with a repeated vertex index", v.repeated_index_faces.count,
-           list(v.repeated_index_faces.examples));
-  }
-  if (v.inconsistent_edges.count) {
-    refuse("edges whose two faces disagree in orientation", v.inconsistent_edges.count,
-           list(v.inconsistent_edges.examples));
+  // Unreferenced vertices, zero-area faces, several components and no faces at all are
+  // representable and accepted.
+  ManifoldRequirements representable;
+  representable.allow_several_components = true;
+  representable.allow_zero_area_faces = true;
+  representable.allow_unreferenced_vertices = true;
+  representable.allow_no_faces = true;
+  representable.validation.max_examples = 5;
+  const std::string problem =
+      manifold_problem(mesh, validate_mesh(mesh, representable.validation), representable);
+  if (!problem.empty()) {
+    throw InvalidInputError(options.name, "cannot build a halfedge mesh: " + problem);
   }
 
   HalfedgeMesh out;

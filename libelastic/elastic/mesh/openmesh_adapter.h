@@ -46,10 +46,10 @@ struct ToOpenMeshOptions {
 
 /// Builds the halfedge mesh of `mesh`.
 /// \throws InvalidInputError naming `options.name` when the mesh cannot be a halfedge mesh:
-/// malformed
-///         faces, non-finite positions, faces with a repeated vertex, non-manifold edges or
-///         vertices, or inconsistently oriented faces (repair_mesh() fixes the last one). OpenMesh
-///         would otherwise print "complex edge" and silently drop faces.
+///         malformed faces, non-finite positions, faces with a repeated vertex, non-manifold
+///         edges or vertices, or inconsistently oriented faces (repair_mesh() fixes the last one),
+///         worded by manifold_problem(). OpenMesh would otherwise print "complex edge" and
+///         silently drop faces.
 HalfedgeMesh to_openmesh(const PolygonMesh& mesh, const ToOpenMeshOptions& options = {});
 
 struct FromOpenMeshOptions {

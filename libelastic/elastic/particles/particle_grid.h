@@ -11,8 +11,7 @@
 /// Rest values are recorded on the source after sampling (§4.2):
 /// - normal spring (i, j): rest length k_ij = |s_j - s_i| (Euclidean source distance, eq. 13);
 /// - angular spring at corner i of a face, between i and the *virtual point* m = (x_a + x_b) / 2,
-/// the
-///   midpoint of i's two neighbours a, b in that face: rest length |s_i - m_source| (Fig. 1).
+///   the midpoint of i's two neighbours a, b in that face: rest length |s_i - m_source| (Fig. 1).
 ///
 /// Flat arrays (`springs`, `angular_springs`) are derived from the mesh by `build_springs()` for
 /// the solvers' inner loops; they stay valid as long as the mesh's connectivity does not change.

@@ -24,8 +24,8 @@
 ///   we keep its force.
 ///
 /// - injectivity barrier (beyond the paper; SpringEnergyOptions::barrier_stiffness > 0):
-///       E_bar = mu * sum_{triangles t} w_t A_t * h(g_t),   h(g) = (g / g0 - 1)^2 for g > g0, else
-///       0
+///       E_bar = mu * sum_{triangles t} w_t A_t * h(g_t),
+///       h(g) = (g / g0 - 1)^2 for g > g0, else 0
 ///   over every triangle of both triangulations of each quad (weight w = 1/2, so each split covers
 ///   the quad once) and every triangle face (w = 1); A_t is the source area and
 ///   g_t = s1^-2 + s2^-2 the inverse part of the symmetric Dirichlet energy of the triangle's
@@ -113,9 +113,8 @@ struct SpringEnergies {
 /// once (it parallelises itself).
 class SpringSystem {
  public:
-  /// \throws InvalidInputError when the grid has no springs or a spring index is out of range, or
-  /// the
-  ///         options are not finite and non-negative (rest_scale positive).
+  /// \throws InvalidInputError when the grid has no springs or a spring index is out of range,
+  ///         or the options are not finite and non-negative (rest_scale positive).
   SpringSystem(const ParticleGrid& grid, const SpringEnergyOptions& options = {});
 
   int num_particles() const { return num_particles_; }

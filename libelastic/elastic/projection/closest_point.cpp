@@ -13,49 +13,18 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
-#include <mutex>
 #include <string>
 #include <utility>
 #include <vector>
 
+#include "elastic/core/detail/embree_handles.h"
 #include "elastic/core/error.h"
+#include "elastic/projection/detail/closest_point_newton.h"
 
 namespace elastic {
 namespace {
 
-constexpr double kEps = std::numeric_limits<double>::epsilon();
 constexpr double kInf = std::numeric_limits<double>::infinity();
-
-// ---------------------------------------------------------------------------------------------------
-// Embree device shared by the process: created with the first projector, released with the last.
-
-struct EmbreeDevice {
-  RTCDevice device = nullptr;
-  EmbreeDevice() : device(rtcNewDevice(nullptr)) {}
-  ~EmbreeDevice() {
-    if (device) {
-      rtcReleaseDevice(device);
-    }
-  }
-  EmbreeDevice(const EmbreeDevice&) = delete;
-  EmbreeDevice& operator=(const EmbreeDevice&) = delete;
-};
-
-std::shared_ptr<EmbreeDevice> shared_embree_device(const std::string& name) {
-  static std::mutex mutex;
-  static std::weak_ptr<EmbreeDevice> weak;
-  std::lock_guard<std::mutex> lock(mutex);
-  std::shared_ptr<EmbreeDevice> device = weak.lock();
-  if (!device) {
-    device = std::make_shared<EmbreeDevice>();
-    if (!device->device) {
-      throw Error(name, "cannot create an Embree device (error " +
-                            std::to_string(static_cast<int>(rtcGetDeviceError(nullptr))) + ")");
-    }
-    weak = device;
-  }
-  return device;
-}
 
 // ---------------------------------------------------------------------------------------------------
 // Closest point on a triangle (Ericson, "Real-Time Collision Detection", §5.1.5, re-derived):
@@ -116,58 +85,6 @@ TriangleHit closest_on_triangle(const Eigen::Vector3d& p, const Eigen::Vector3d&
   return finish(vb / sum, vc / sum);  // face interior
 }
 
-// ---------------------------------------------------------------------------------------------------
-// The edges of a ptex face's parameter domain, as half-planes n.(u,v) >= c with inward unit normal
-// n and unit tangent t. Quads: v=0, u=1, v=1, u=0. Loop triangles: v=0, u+v=1, u=0.
-
-struct DomainEdge {
-  Eigen::Vector2d normal;   // inward
-  double offset;            // n.(u,v) >= offset inside
-  Eigen::Vector2d tangent;  // along the edge
-  Eigen::Vector2d midpoint;
-};
-
-const std::array<DomainEdge, 4>& quad_edges() {
-  static const std::array<DomainEdge, 4> edges{{
-      {{0.0, 1.0}, 0.0, {1.0, 0.0}, {0.5, 0.0}},
-      {{-1.0, 0.0}, -1.0, {0.0, 1.0}, {1.0, 0.5}},
-      {{0.0, -1.0}, -1.0, {1.0, 0.0}, {0.5, 1.0}},
-      {{1.0, 0.0}, 0.0, {0.0, 1.0}, {0.0, 0.5}},
-  }};
-  return edges;
-}
-
-const std::array<DomainEdge, 3>& triangle_edges() {
-  static const double h = std::sqrt(0.5);
-  static const std::array<DomainEdge, 3> edges{{
-      {{0.0, 1.0}, 0.0, {1.0, 0.0}, {0.5, 0.0}},
-      {{-h, -h}, -h, {-h, h}, {0.5, 0.5}},
-      {{1.0, 0.0}, 0.0, {0.0, 1.0}, {0.0, 0.5}},
-  }};
-  return edges;
-}
-
-// A point closer than this (in ptex units) to a boundary edge is on it: walk() clips exactly onto
-// the boundary, so the slack only absorbs round-off in (u, v).
-constexpr double kActiveTolerance = 1e-11;
-
-// Most backtracking halvings of a Newton step before the iteration gives up.
-constexpr int kMaxHalvings = 30;
-
-// Most chart hops at face corners per Newton run (a vertex has rarely more than 8 faces).
-constexpr int kMaxHops = 8;
-
-// One Newton run's outcome.
-struct NewtonRun {
-  SurfacePoint point;
-  SurfaceDerivatives d;
-  double dist2 = kInf;
-  double travel = 0.0;                                  // summed parameter-space step lengths
-  Eigen::Vector2d last_step = Eigen::Vector2d::Zero();  // the sub-tolerance step not taken
-  bool converged = false;
-  bool on_boundary = false;
-};
-
 }  // namespace
 
 // ---------------------------------------------------------------------------------------------------
@@ -176,8 +93,7 @@ struct SurfaceProjector::Impl {
   const LimitSurface* surface = nullptr;
   ProjectionOptions options;
   LimitTessellation tessellation;
-  bool triangular = false;
-  int num_edges = 4;  // domain edges per ptex face
+  PtexDomain domain{false};  // every ptex face's parameter domain
   // Per triangle: its three corners as grid nodes (i, j) of its own ptex face f, (u, v) = (i, j) /
   // n_f.
   std::vector<std::array<std::uint16_t, 6>> corner_nodes;
@@ -190,19 +106,9 @@ struct SurfaceProjector::Impl {
   double tessellation_error = 0.0;
   // Bounding-box diagonal of the tessellation (absolute slack for float rounding in the BVH).
   double scale = 1.0;
-  std::shared_ptr<EmbreeDevice> device;
-  RTCScene scene = nullptr;
-
-  ~Impl() {
-    if (scene) {
-      rtcReleaseScene(scene);
-    }
-  }
-
-  const DomainEdge& edge(int k) const {
-    return triangular ? triangle_edges()[static_cast<size_t>(k)]
-                      : quad_edges()[static_cast<size_t>(k)];
-  }
+  // Embree: the process's shared device, and the scene of the tessellation's triangles.
+  std::shared_ptr<detail::EmbreeDevice> device;
+  std::unique_ptr<detail::EmbreeScene> scene;
 
   void build_corner_nodes();
   void build_boundary_edges();
@@ -219,8 +125,10 @@ struct SurfaceProjector::Impl {
   SurfacePoint seed(int triangle, double w1, double w2) const;
 
   void check_query(const Eigen::Vector3d& x) const;
-  NewtonRun newton(const Eigen::Vector3d& x, SurfacePoint start) const;
-  ClosestPoint finish(const Eigen::Vector3d& x, const NewtonRun& run) const;
+  detail::NewtonRun newton(const Eigen::Vector3d& x, const SurfacePoint& start) const {
+    return detail::newton_closest_point({surface, domain, &options, &boundary_edges}, x, start);
+  }
+  ClosestPoint finish(const Eigen::Vector3d& x, const detail::NewtonRun& run) const;
   ClosestPoint global(const Eigen::Vector3d& x) const;
   ClosestPoint warm(const Eigen::Vector3d& x, const SurfacePoint& hint) const;
 };
@@ -235,7 +143,7 @@ void SurfaceProjector::Impl::build_corner_nodes() {
   corner_nodes.assign(num_triangles, {});
   const int num_faces = surface->num_faces();
   face_resolution.assign(static_cast<size_t>(num_faces), t.resolution);
-  if (!triangular) {
+  if (!domain.triangle()) {
     const PolygonMesh& mesh = surface->control_mesh();
     for (int f = 0; f < num_faces; ++f) {
       if (mesh.face_size(surface->control_face(f)) != 4) {
@@ -283,9 +191,9 @@ void SurfaceProjector::Impl::build_corner_nodes() {
               node_positions.clear();
               for (int a = 0; a <= n; ++a) {
                 for (int b = 0; b <= n; ++b) {
-                  const bool on_edge = triangular ? (a == 0 || b == 0 || a + b == n)
-                                                  : (a == 0 || b == 0 || a == n || b == n);
-                  if (!on_edge || (triangular && a + b > n)) {
+                  const bool on_edge = domain.triangle() ? (a == 0 || b == 0 || a + b == n)
+                                                         : (a == 0 || b == 0 || a == n || b == n);
+                  if (!on_edge || (domain.triangle() && a + b > n)) {
                     continue;
                   }
                   nodes.push_back({a, b});
@@ -321,8 +229,8 @@ void SurfaceProjector::Impl::build_boundary_edges() {
   boundary_edges.assign(static_cast<size_t>(num_faces), 0);
   for (int f = 0; f < num_faces; ++f) {
     std::uint8_t mask = 0;
-    for (int k = 0; k < num_edges; ++k) {
-      const Eigen::Vector2d m = edge(k).midpoint;
+    for (int k = 0; k < domain.num_corners(); ++k) {
+      const Eigen::Vector2d m = domain.edge(k).midpoint;
       if (surface->on_boundary({f, m.x(), m.y()})) {
         mask = static_cast<std::uint8_t>(mask | (1u << k));
       }
@@ -362,12 +270,12 @@ void SurfaceProjector::Impl::estimate_tessellation_error() {
 
 void SurfaceProjector::Impl::build_scene() {
   const std::string& name = surface->name();
-  device = shared_embree_device(name);
+  device = detail::shared_embree_device(name);
   const LimitTessellation& t = tessellation;
-  scene = rtcNewScene(device->device);
-  RTCGeometry geometry = rtcNewGeometry(device->device, RTC_GEOMETRY_TYPE_TRIANGLE);
-  if (!scene || !geometry) {
-    throw Error(name, "cannot create the Embree scene");
+  scene = std::make_unique<detail::EmbreeScene>(device->get(), name);
+  RTCGeometry geometry = rtcNewGeometry(device->get(), RTC_GEOMETRY_TYPE_TRIANGLE);
+  if (!geometry) {
+    throw Error(name, "cannot create the Embree geometry");
   }
   // Float vertices are enough: the BVH only picks seed triangles, whose distances are recomputed in
   // double from the tessellation's own positions in the callback.
@@ -392,14 +300,10 @@ void SurfaceProjector::Impl::build_scene() {
     }
   }
   rtcCommitGeometry(geometry);
-  rtcAttachGeometry(scene, geometry);
+  rtcAttachGeometry(scene->get(), geometry);
   rtcReleaseGeometry(geometry);
-  rtcCommitScene(scene);
-  const RTCError error = rtcGetDeviceError(device->device);
-  if (error != RTC_ERROR_NONE) {
-    throw Error(name, "Embree failed to build the BVH (error " +
-                          std::to_string(static_cast<int>(error)) + ")");
-  }
+  rtcCommitScene(scene->get());
+  detail::check_embree(device->get(), name, "build the BVH");
 }
 
 SurfacePoint SurfaceProjector::Impl::seed(int triangle, double w1, double w2) const {
@@ -411,16 +315,9 @@ SurfacePoint SurfaceProjector::Impl::seed(int triangle, double w1, double w2) co
   w2 = (1.0 - kPull) * w2 + kPull / 3.0;
   const Eigen::Vector2d uv = (1.0 - w1 - w2) * node_uv(triangle, 0) + w1 * node_uv(triangle, 1) +
                              w2 * node_uv(triangle, 2);
-  SurfacePoint p{tessellation.triangle_face[static_cast<size_t>(triangle)], uv.x(), uv.y()};
   // Round-off in the blend must not leave the domain.
-  p.u = std::clamp(p.u, 0.0, 1.0);
-  p.v = std::clamp(p.v, 0.0, 1.0);
-  if (triangular && p.u + p.v > 1.0) {
-    const double s = p.u + p.v;
-    p.u /= s;
-    p.v /= s;
-  }
-  return p;
+  return domain.clamp(
+      SurfacePoint{tessellation.triangle_face[static_cast<size_t>(triangle)], uv.x(), uv.y()});
 }
 
 void SurfaceProjector::Impl::check_query(const Eigen::Vector3d& x) const {
@@ -431,283 +328,8 @@ void SurfaceProjector::Impl::check_query(const Eigen::Vector3d& x) const {
   }
 }
 
-// Newton's method on E(u,v) = 1/2 |d(u,v) - x|^2 from `start`.
-//
-//   gradient  g = J^T r,                      r = d - x, J = [d_u d_v]
-//   Hessian   H = J^T J + sum_i r_i d2 d_i    (the second term is r . d_uu, r . d_uv, r . d_vv)
-//
-// H is positive definite near a non-degenerate minimum (it fails only when the query is beyond a
-// focal point, e.g. near the centre of curvature). When it is not, a modified Newton step with the
-// absolute values of H's eigenvalues (floored) gives a descent step (see free_step). Steps are
-// capped at `max_step`, applied with walk() (which crosses ptex edges), and halved until E does not
-// grow beyond its round-off (the backtracking guard). Every accepted trial point's derivatives are
-// the next iteration's, so an iteration costs one evaluation.
-//
-// Boundaries are an active set: on a boundary edge of the domain, if steepest descent points out of
-// the surface, the step is a 1D Newton step along the edge tangent t (g_t = t.g, h_t = |t^T H t|);
-// at a corner of two boundary edges the descent direction is projected on each edge ray and the
-// iteration stops (a KKT point) when neither ray descends.
-//
-// Convergence: the step is below `parameter_tolerance`, or the (projected) gradient is zero to
-// round-off. r carries an absolute error of a few eps (|x| + |d|) per component, so g_u = d_u . r
-// cannot be resolved below |d_u| times that.
-//
-// Face corners: where a step leaves the face through a corner and no step length descends, the
-// iteration hops into the neighbouring face (see the hop below) and continues in that chart.
-NewtonRun SurfaceProjector::Impl::newton(const Eigen::Vector3d& x, SurfacePoint p) const {
-  const LimitSurface& s = *surface;
-  const double tolerance = options.parameter_tolerance;
-  const double early_tolerance = 1e-2 * std::sqrt(tolerance);
-  NewtonRun run;
-  SurfaceDerivatives d = s.derivatives(p);
-  Eigen::Vector3d r = d.position - x;
-  double energy = 0.5 * r.squaredNorm();
-  int hops = 0;  // chart hops at face corners (see below)
-  auto at_corner = [&](const SurfacePoint& q) {
-    int on = 0;
-    for (int k = 0; k < num_edges; ++k) {
-      on += edge(k).normal.dot(q.uv()) - edge(k).offset <= 1e-9;
-    }
-    return on >= 2;
-  };
-
-  for (int iteration = 0; iteration < options.max_newton_iterations; ++iteration) {
-    const Eigen::Vector2d g(d.du.dot(r), d.dv.dot(r));
-    const double g00 = d.du.squaredNorm(), g01 = d.du.dot(d.dv), g11 = d.dv.squaredNorm();
-    const double h00 = g00 + r.dot(d.duu), h01 = g01 + r.dot(d.duv), h11 = g11 + r.dot(d.dvv);
-    const double r_noise =
-        8.0 * kEps * (x.cwiseAbs().maxCoeff() + d.position.cwiseAbs().maxCoeff());
-    const double noise_u = 2.0 * r_noise * std::sqrt(g00), noise_v = 2.0 * r_noise * std::sqrt(g11);
-
-    // Solves A s = -b for the 2x2 symmetric A; false when A is not safely positive definite.
-    // Curvatures smaller than this (relative to the metric J^T J) are raised to it: the step along
-    // such a direction is then long and capped by max_step.
-    const double curvature_floor = 1e-6 * (g00 + g11) + 1e-300;
-    // Newton step when H is safely positive definite. Otherwise (beyond a focal point, or where E
-    // is flat) the "saddle-free" Newton step: H's eigenvalues replaced by their absolute values
-    // (floored), so a direction of negative curvature is followed downhill with a long step instead
-    // of the creeping Gauss-Newton step (J^T J overestimates the curvature there: measured on a
-    // torus, GN needed more than 30 iterations from inside the tube where this takes a few).
-    bool pure_newton = false;  // the step below is an exact Newton step (H positive definite)
-    auto free_step = [&]() {
-      const double det = h00 * h11 - h01 * h01;
-      if (h00 > 0.0 && h11 > 0.0 && det > 1e-12 * h00 * h11) {
-        pure_newton = true;
-        return Eigen::Vector2d(-(h11 * g.x() - h01 * g.y()) / det,
-                               -(h00 * g.y() - h01 * g.x()) / det);
-      }
-      const double mean = 0.5 * (h00 + h11);
-      const double radius = std::hypot(0.5 * (h00 - h11), h01);
-      const double l1 = mean + radius, l2 = mean - radius;
-      Eigen::Vector2d v1 = std::abs(h01) > 1e-300 ? Eigen::Vector2d(l1 - h11, h01).normalized()
-                           : h00 >= h11           ? Eigen::Vector2d(1.0, 0.0)
-                                                  : Eigen::Vector2d(0.0, 1.0);
-      const Eigen::Vector2d v2(-v1.y(), v1.x());
-      return Eigen::Vector2d(-v1.dot(g) / std::max(std::abs(l1), curvature_floor) * v1 -
-                             v2.dot(g) / std::max(std::abs(l2), curvature_floor) * v2);
-    };
-    // 1D Newton along a unit direction t (a boundary edge), with the same absolute-curvature rule.
-    auto edge_step = [&](const Eigen::Vector2d& t) {
-      const double ht = t.x() * t.x() * h00 + 2.0 * t.x() * t.y() * h01 + t.y() * t.y() * h11;
-      const double jt = t.x() * t.x() * g00 + 2.0 * t.x() * t.y() * g01 + t.y() * t.y() * g11;
-      pure_newton = ht > 1e-6 * jt;
-      return Eigen::Vector2d(-t.dot(g) / std::max(std::abs(ht), 1e-6 * jt + 1e-300) * t);
-    };
-    // Steepest descent scaled by the curvature along it (a Cauchy step), used when Newton's step
-    // would leave through a boundary edge although descent points inside.
-    auto descent_step = [&]() {
-      const double gg = g.squaredNorm();
-      if (!(gg > 0.0)) {
-        return Eigen::Vector2d(Eigen::Vector2d::Zero());
-      }
-      const double ghg = g.x() * g.x() * h00 + 2.0 * g.x() * g.y() * h01 + g.y() * g.y() * h11;
-      const double gjg = g.x() * g.x() * g00 + 2.0 * g.x() * g.y() * g01 + g.y() * g.y() * g11;
-      return Eigen::Vector2d(-gg / std::max(std::abs(ghg), 1e-6 * gjg + 1e-300) * g);
-    };
-    auto gradient_zero = [&](const Eigen::Vector2d& direction) {
-      // Round-off bound of g along a unit parameter direction.
-      const double noise = std::abs(direction.x()) * noise_u + std::abs(direction.y()) * noise_v;
-      return std::abs(direction.dot(g)) <= noise;
-    };
-
-    // Active boundary edges of this face at p.
-    int active[2] = {-1, -1};
-    int num_active = 0;
-    const std::uint8_t mask = boundary_edges[static_cast<size_t>(p.face)];
-    if (mask) {
-      const Eigen::Vector2d uv = p.uv();
-      for (int k = 0; k < num_edges && num_active < 2; ++k) {
-        if (!(mask & (1u << k))) {
-          continue;
-        }
-        const DomainEdge& e = edge(k);
-        if (e.normal.dot(uv) - e.offset <= kActiveTolerance) {
-          active[num_active++] = k;
-        }
-      }
-    }
-
-    Eigen::Vector2d step;
-    bool constrained = false;
-    if (num_active == 0) {
-      if (gradient_zero({1.0, 0.0}) && gradient_zero({0.0, 1.0})) {
-        run.converged = true;
-        break;
-      }
-      step = free_step();
-    } else if (num_active == 1) {
-      const DomainEdge& e = edge(active[0]);
-      if (-g.dot(e.normal) <= 0.0) {  // descent points out of the surface: slide along the edge
-        constrained = true;
-        if (gradient_zero(e.tangent)) {
-          run.converged = true;
-          run.on_boundary = true;
-          break;
-        }
-        step = edge_step(e.tangent);
-      } else {
-        step = free_step();
-        if (step.dot(e.normal) < 0.0) {
-          step = descent_step();
-        }
-      }
-    } else {
-      const DomainEdge& a = edge(active[0]);
-      const DomainEdge& b = edge(active[1]);
-      if (-g.dot(a.normal) > 0.0 && -g.dot(b.normal) > 0.0) {
-        step = free_step();
-        if (step.dot(a.normal) < 0.0 || step.dot(b.normal) < 0.0) {
-          step = descent_step();
-        }
-      } else {
-        // Rays from the corner along each boundary edge, pointing into the domain.
-        const Eigen::Vector2d ray_a =
-            a.tangent.dot(b.normal) >= 0.0 ? a.tangent : Eigen::Vector2d(-a.tangent);
-        const Eigen::Vector2d ray_b =
-            b.tangent.dot(a.normal) >= 0.0 ? b.tangent : Eigen::Vector2d(-b.tangent);
-        constrained = true;
-        if (-g.dot(ray_a) > 0.0 && !gradient_zero(ray_a)) {
-          step = edge_step(ray_a);
-        } else if (-g.dot(ray_b) > 0.0 && !gradient_zero(ray_b)) {
-          step = edge_step(ray_b);
-        } else {
-          run.converged = true;  // KKT point at a boundary corner
-          run.on_boundary = true;
-          break;
-        }
-      }
-    }
-
-    const double length = step.norm();
-    if (length > options.max_step) {
-      step *= options.max_step / length;
-    }
-    if (!(step.norm() >= tolerance)) {  // also catches a NaN step
-      run.converged = step.allFinite();
-      run.on_boundary = constrained;
-      if (run.converged) {
-        run.last_step = step;
-      }
-      break;
-    }
-    // A pure Newton step this short ends within ~C |s|^2 (~1e-16 C) of the minimum, and d(p + s) is
-    // d(p) + J s to O(|s|^2): finish() takes it without another evaluation (the last of the ~4 a
-    // warm start costs). Only inside the face (a step off it needs walk()).
-    if (pure_newton && step.norm() <= early_tolerance) {
-      const Eigen::Vector2d uv = p.uv() + step;
-      if (uv.x() >= 0.0 && uv.y() >= 0.0 &&
-          (triangular ? uv.x() + uv.y() <= 1.0 : uv.x() <= 1.0 && uv.y() <= 1.0)) {
-        run.converged = true;
-        run.on_boundary = constrained;
-        run.last_step = step;
-        break;
-      }
-    }
-
-    // Backtracking guard on E: accept when E does not grow beyond its own round-off.
-    const double slack = 4.0 * std::sqrt(2.0 * energy) * r_noise + 1e-300;
-    const Eigen::Vector2d first_step = step;
-    bool accepted = false;
-    SurfacePoint trial;
-    SurfaceDerivatives trial_d;
-    Eigen::Vector3d trial_r;
-    double trial_energy = energy;
-    for (int halving = 0; halving < kMaxHalvings; ++halving) {
-      trial = s.walk(p, step);
-      if (trial == p) {
-        // walk() cannot leave through a face corner (around an extraordinary vertex there is no
-        // continuous chart to carry the direction on); start a hair (1e-9) inside the face so the
-        // path leaves through an edge instead. A boundary still stops it.
-        SurfacePoint inside = p;
-        const double centre = triangular ? 1.0 / 3.0 : 0.5;
-        const Eigen::Vector2d towards = Eigen::Vector2d(centre - p.u, centre - p.v).normalized();
-        inside.u += 1e-9 * towards.x();
-        inside.v += 1e-9 * towards.y();
-        trial = s.walk(inside, step);
-      }
-      trial_d = s.derivatives(trial);
-      trial_r = trial_d.position - x;
-      trial_energy = 0.5 * trial_r.squaredNorm();
-      if (trial_energy <= energy + slack) {
-        accepted = true;
-        break;
-      }
-      step *= 0.5;
-      if (step.norm() < tolerance) {
-        break;
-      }
-    }
-    if (!accepted && hops < kMaxHops && at_corner(p)) {
-      // At a face corner a straight step in this face's chart may leave through the corner into a
-      // sector where the chart does not continue smoothly (ptex charts are only C0 across edges at
-      // an extraordinary vertex), so no step length descends. Hop 1e-7 into the neighbouring face
-      // the step points to and recompute the step in that chart; E may grow by ~1e-7 |g| once per
-      // hop.
-      const double centre = triangular ? 1.0 / 3.0 : 0.5;
-      const Eigen::Vector2d towards = Eigen::Vector2d(centre - p.u, centre - p.v).normalized();
-      const SurfacePoint inside{p.face, p.u + 1e-9 * towards.x(), p.v + 1e-9 * towards.y()};
-      trial = s.walk(inside, 1e-7 * first_step.normalized());
-      if (trial.face != p.face) {
-        ++hops;
-        trial_d = s.derivatives(trial);
-        trial_r = trial_d.position - x;
-        trial_energy = 0.5 * trial_r.squaredNorm();
-        accepted = true;
-        step = Eigen::Vector2d::Zero();
-      }
-    }
-    if (!accepted) {
-      // No descent at any step length above the tolerance: p is a minimum to within round-off.
-      run.converged = step.norm() < tolerance;
-      run.on_boundary = constrained;
-      break;
-    }
-    if (trial == p) {
-      break;  // blocked (walk could not move): leave it unconverged
-    }
-    run.travel += step.norm();
-    p = trial;
-    d = trial_d;
-    r = trial_r;
-    energy = trial_energy;
-  }
-
-  run.point = p;
-  run.d = d;
-  run.dist2 = r.squaredNorm();
-  if (!run.on_boundary && run.converged) {
-    // A converged interior point can still sit on a boundary edge when descent points along it.
-    const std::uint8_t mask = boundary_edges[static_cast<size_t>(p.face)];
-    for (int k = 0; k < num_edges && mask; ++k) {
-      if ((mask & (1u << k)) && edge(k).normal.dot(p.uv()) - edge(k).offset <= kActiveTolerance) {
-        run.on_boundary = true;
-      }
-    }
-  }
-  return run;
-}
-
-ClosestPoint SurfaceProjector::Impl::finish(const Eigen::Vector3d& x, const NewtonRun& run) const {
+ClosestPoint SurfaceProjector::Impl::finish(const Eigen::Vector3d& x,
+                                            const detail::NewtonRun& run) const {
   ClosestPoint out;
   out.point = run.point;
   out.position = run.d.position;
@@ -716,8 +338,7 @@ ClosestPoint SurfaceProjector::Impl::finish(const Eigen::Vector3d& x, const Newt
   // with |s|^2 <= 1e-16 (for the default tolerance), at the level of round-off; likewise the
   // tangents for the normal. Only when p + s stays in the face (a step off it would need walk()).
   const Eigen::Vector2d uv = run.point.uv() + run.last_step;
-  const bool inside = uv.x() >= 0.0 && uv.y() >= 0.0 &&
-                      (triangular ? uv.x() + uv.y() <= 1.0 : uv.x() <= 1.0 && uv.y() <= 1.0);
+  const bool inside = domain.contains(uv);
   if (inside && run.last_step != Eigen::Vector2d::Zero()) {
     out.point.u = uv.x();
     out.point.v = uv.y();
@@ -734,12 +355,10 @@ ClosestPoint SurfaceProjector::Impl::finish(const Eigen::Vector3d& x, const Newt
   Eigen::Vector3d n = du.cross(dv);
   if (!(n.norm() > 1e-12 * du.norm() * dv.norm())) {
     // Degenerate parametrisation at this point (a collapsed partial derivative at an extraordinary
-    // vertex, say): take the normal a hair towards the face centre, where it is regular.
-    SurfacePoint q = run.point;
-    const double centre = triangular ? 1.0 / 3.0 : 0.5;
-    q.u += 1e-7 * (centre - q.u);
-    q.v += 1e-7 * (centre - q.v);
-    const SurfaceDerivatives dq = surface->derivatives(q);
+    // vertex, say): take the normal a hair towards the face centre, where it is regular (the one
+    // nudge off a singular parameterisation, as LimitSurface::curvature takes it).
+    const SurfaceDerivatives dq =
+        surface->derivatives(domain.towards_centre(run.point, kSingularNudge));
     n = dq.du.cross(dq.dv);
   }
   const double length = n.norm();
@@ -807,7 +426,7 @@ ClosestPoint SurfaceProjector::Impl::global(const Eigen::Vector3d& x) const {
   point_query.radius = std::numeric_limits<float>::infinity();
   RTCPointQueryContext context;
   rtcInitPointQueryContext(&context);
-  rtcPointQuery(scene, &point_query, &context, callback, &query);
+  rtcPointQuery(scene->get(), &point_query, &context, callback, &query);
   if (query.best_triangle < 0) {
     // Only when the query point overflows float: fall back to a scan.
     for (size_t k = 0; k < tessellation.triangles.size(); ++k) {
@@ -822,7 +441,7 @@ ClosestPoint SurfaceProjector::Impl::global(const Eigen::Vector3d& x) const {
       }
     }
   }
-  NewtonRun best = newton(x, seed(query.best_triangle, query.best.w1, query.best.w2));
+  detail::NewtonRun best = newton(x, seed(query.best_triangle, query.best.w1, query.best.w2));
 
   // Second pass: triangles nearer than D + eps may carry a nearer limit point (see the header).
   if (options.max_global_seeds > 1) {
@@ -830,7 +449,7 @@ ClosestPoint SurfaceProjector::Impl::global(const Eigen::Vector3d& x) const {
     query.limit = limit;
     point_query.radius = static_cast<float>(limit * (1.0 + 1e-5) + 1e-6 * scale) * 1.0001f;
     rtcInitPointQueryContext(&context);
-    rtcPointQuery(scene, &point_query, &context, callback, &query);
+    rtcPointQuery(scene->get(), &point_query, &context, callback, &query);
     std::sort(query.candidates.begin(), query.candidates.begin() + query.num_candidates,
               [](const auto& a, const auto& b) { return a.first.dist2 < b.first.dist2; });
     std::array<Eigen::Vector3d, 16> tried;
@@ -862,7 +481,7 @@ ClosestPoint SurfaceProjector::Impl::global(const Eigen::Vector3d& x) const {
       if (near_tried) {
         continue;
       }
-      NewtonRun run = newton(x, seed(triangle, hit.w1, hit.w2));
+      detail::NewtonRun run = newton(x, seed(triangle, hit.w1, hit.w2));
       ++runs;
       if (num_tried < static_cast<int>(tried.size())) {
         tried[static_cast<size_t>(num_tried++)] = run.d.position;
@@ -887,15 +506,7 @@ ClosestPoint SurfaceProjector::Impl::warm(const Eigen::Vector3d& x,
                                                  std::to_string(hint.v) +
                                                  ") is not on the surface");
   }
-  SurfacePoint start = hint;
-  start.u = std::clamp(start.u, 0.0, 1.0);
-  start.v = std::clamp(start.v, 0.0, 1.0);
-  if (triangular && start.u + start.v > 1.0) {
-    const double sum = start.u + start.v;
-    start.u /= sum;
-    start.v /= sum;
-  }
-  const NewtonRun run = newton(x, start);
+  const detail::NewtonRun run = newton(x, domain.clamp(hint));
   if (!run.converged || run.travel > options.warm_start_max_travel) {
     return global(x);
   }
@@ -926,8 +537,7 @@ SurfaceProjector::SurfaceProjector(const LimitSurface& surface, const Projection
   Impl& impl = *impl_;
   impl.surface = &surface;
   impl.options = options;
-  impl.triangular = surface.triangular_domain();
-  impl.num_edges = impl.triangular ? 3 : 4;
+  impl.domain = surface.domain();
   impl.tessellation = tessellate(surface, options.tessellation);
   if (impl.tessellation.triangles.empty()) {
     throw InvalidInputError(name, "the surface has no triangles to project on");

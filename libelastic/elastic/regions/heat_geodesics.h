@@ -8,11 +8,9 @@
 ///    Laplacian (positive semi-definite). The source is a point of a triangle: delta is spread over
 ///    the triangle's corners by barycentric weight.
 /// 2. X = -grad u / |grad u| per triangle: unit vectors pointing away from the source (Varadhan:
-/// the
-///    heat kernel's level sets approach geodesic circles as t -> 0).
+///    the heat kernel's level sets approach geodesic circles as t -> 0).
 /// 3. L phi = -div X, solved with phi pinned to 0 at the corner of the source triangle nearest the
-/// source
-///    (the pin absorbs the boundary flux of an open mesh, where the Neumann problem is
+///    source (the pin absorbs the boundary flux of an open mesh, where the Neumann problem is
 ///    inconsistent); phi is then shifted to vanish at the source.
 ///
 /// Accuracy: phi converges to the smooth surface's geodesic distance as h -> 0; the error is O(h)

@@ -5,10 +5,9 @@
 /// building block of the baselines.
 ///
 /// - Disk: Floater's mean-value coordinates with the boundary fixed on the unit circle by
-/// normalised arc
-///   length starting at the region's anchor (angle 0), counter-clockwise. Bijective for any valid
-///   region (Floater 2003: mean-value weights are positive on a convex boundary), so it never
-///   folds.
+///   normalised arc length starting at the region's anchor (angle 0), counter-clockwise. Bijective
+///   for any valid region (Floater 2003: mean-value weights are positive on a convex boundary), so
+///   it never folds.
 /// - Conformal: least-squares conformal map with a free boundary, scaled to the region's 3D area;
 ///   falls back to Disk if it folds (result says so).
 

@@ -3,13 +3,14 @@
 /// Region specifications, as a user gives them on the command line or in the API, and building a
 /// Region from one on a surface:
 ///
+// clang-format off
 ///   disk:X,Y,Z,R     the geodesic disk of radius R around the surface point nearest to (X,Y,Z)
-///   points:FILE      a closed curve through 3+ points (one "x y z" per line), each projected onto
-///   the
-///                    surface, joined in order by shortest paths on the surface
+///   points:FILE      a closed curve through 3+ points (one "x y z" per line), each projected
+///                    onto the surface, joined in order by shortest paths on the surface
 ///   boundary         the surface's own boundary loop (an open surface with exactly one)
-///   uv:FILE          a closed polygon (one "u v" per line) in the texture domain of a mesh with
-///   UVs
+///   uv:FILE          a closed polygon (one "u v" per line) in the texture domain of a mesh
+///                    with UVs
+// clang-format on
 ///
 /// The region is the side of the curve that is a disk; when both sides are disks (a closed genus-0
 /// surface) the smaller one by area. Its boundary is oriented counter-clockwise seen from the

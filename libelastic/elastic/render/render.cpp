@@ -14,46 +14,15 @@
 #include <string>
 #include <utility>
 
+#include "elastic/core/detail/embree_handles.h"
 #include "elastic/core/error.h"
 
 namespace elastic {
 namespace {
 
-// ---------------------------------------------------------------------------------------------------
-// Embree handles with RAII.
-
-struct Device {
-  RTCDevice handle = rtcNewDevice(nullptr);
-  Device() {
-    if (!handle) {
-      throw Error("render", "cannot create an Embree device (error " +
-                                std::to_string(static_cast<int>(rtcGetDeviceError(nullptr))) + ")");
-    }
-  }
-  ~Device() { rtcReleaseDevice(handle); }
-  Device(const Device&) = delete;
-  Device& operator=(const Device&) = delete;
-};
-
-struct EmbreeScene {
-  RTCScene handle;
-  explicit EmbreeScene(RTCDevice device) : handle(rtcNewScene(device)) {}
-  ~EmbreeScene() {
-    if (handle) {
-      rtcReleaseScene(handle);
-    }
-  }
-  EmbreeScene(const EmbreeScene&) = delete;
-  EmbreeScene& operator=(const EmbreeScene&) = delete;
-};
-
-void check_device(RTCDevice device, const char* what) {
-  const RTCError error = rtcGetDeviceError(device);
-  if (error != RTC_ERROR_NONE) {
-    throw Error("render", std::string("Embree failed to ") + what + " (error " +
-                              std::to_string(static_cast<int>(error)) + ")");
-  }
-}
+using detail::check_embree;
+using detail::EmbreeDevice;
+using detail::EmbreeScene;
 
 // ---------------------------------------------------------------------------------------------------
 // Counter-based random numbers: SplitMix64's finaliser hashes (seed, pixel, sample, stream) into a
@@ -276,8 +245,8 @@ class Tracer {
       : camera_(camera),
         options_(options),
         frame_(camera_frame(camera)),
-        surfaces_(device_.handle),
-        wires_(device_.handle) {
+        surfaces_(device_.get(), "render"),
+        wires_(device_.get(), "render") {
     const Eigen::AlignedBox3d box = bounding_box(scene);
     if (!box.isEmpty()) {
       shift_ = box.center();
@@ -312,10 +281,10 @@ class Tracer {
       }
     }
     // Robust (watertight) triangle tests: no background pixels leaking through shared edges.
-    rtcSetSceneFlags(surfaces_.handle, RTC_SCENE_FLAG_ROBUST);
-    rtcCommitScene(surfaces_.handle);
-    rtcCommitScene(wires_.handle);
-    check_device(device_.handle, "build the scene");
+    rtcSetSceneFlags(surfaces_.get(), RTC_SCENE_FLAG_ROBUST);
+    rtcCommitScene(surfaces_.get());
+    rtcCommitScene(wires_.get());
+    check_embree(device_.get(), "render", "build the scene");
     wire_slack_ = static_cast<float>(options.wire_depth_tolerance * diagonal_);
   }
 
@@ -327,7 +296,7 @@ class Tracer {
     RTCRayHit query = make_ray(origin, direction, 0.0, std::numeric_limits<float>::infinity());
     RTCIntersectContext context;
     rtcInitIntersectContext(&context);
-    rtcIntersect1(surfaces_.handle, &context, &query);
+    rtcIntersect1(surfaces_.get(), &context, &query);
     // Wires win over the surface seen when they are in front of it or at most `wire_slack_`
     // behind it along the ray (a grid on the limit surface lies just under the control mesh).
     RTCRayHit wire = make_ray(origin, direction, 0.0,
@@ -335,7 +304,7 @@ class Tracer {
                                   ? std::numeric_limits<float>::infinity()
                                   : query.ray.tfar + wire_slack_);
     rtcInitIntersectContext(&context);
-    rtcIntersect1(wires_.handle, &context, &wire);
+    rtcIntersect1(wires_.get(), &context, &wire);
 
     if (wire.hit.geomID != RTC_INVALID_GEOMETRY_ID) {
       const PreparedObject& prepared =
@@ -452,7 +421,7 @@ class Tracer {
       RTCRay ray = make_ray(origin, d, 0.0, radius).ray;
       RTCIntersectContext context;
       rtcInitIntersectContext(&context);
-      rtcOccluded1(surfaces_.handle, &context, &ray);  // wires cast no occlusion
+      rtcOccluded1(surfaces_.get(), &context, &ray);  // wires cast no occlusion
       // Embree sets tfar to -inf when the ray is blocked.
       if (ray.tfar >= 0.0f) {
         ++open;
@@ -506,7 +475,7 @@ class Tracer {
 
   void attach(RTCGeometry geometry, int object, bool curve) {
     rtcCommitGeometry(geometry);
-    const unsigned id = rtcAttachGeometry((curve ? wires_ : surfaces_).handle, geometry);
+    const unsigned id = rtcAttachGeometry((curve ? wires_ : surfaces_).get(), geometry);
     rtcReleaseGeometry(geometry);
     std::vector<int>& objects = curve ? wire_objects_ : surface_objects_;
     if (objects.size() <= id) {
@@ -528,7 +497,7 @@ class Tracer {
     if (prepared.triangle_corners.empty()) {
       return;
     }
-    RTCGeometry geometry = rtcNewGeometry(device_.handle, RTC_GEOMETRY_TYPE_TRIANGLE);
+    RTCGeometry geometry = rtcNewGeometry(device_.get(), RTC_GEOMETRY_TYPE_TRIANGLE);
     auto* vertices = static_cast<float*>(
         rtcSetNewGeometryBuffer(geometry, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
                                 3 * sizeof(float), mesh.positions.size()));
@@ -537,7 +506,7 @@ class Tracer {
                                 3 * sizeof(unsigned), prepared.triangle_corners.size()));
     if (!vertices || !indices) {
       rtcReleaseGeometry(geometry);
-      check_device(device_.handle, "allocate triangles");
+      check_embree(device_.get(), "render", "allocate triangles");
       throw Error("render", "Embree could not allocate the triangles of " + object_name(k));
     }
     for (size_t v = 0; v < mesh.positions.size(); ++v) {
@@ -563,7 +532,7 @@ class Tracer {
       return;
     }
     // One two-vertex round linear curve (a capsule-like tube) per edge: vertices (x, y, z, radius).
-    RTCGeometry geometry = rtcNewGeometry(device_.handle, RTC_GEOMETRY_TYPE_ROUND_LINEAR_CURVE);
+    RTCGeometry geometry = rtcNewGeometry(device_.get(), RTC_GEOMETRY_TYPE_ROUND_LINEAR_CURVE);
     auto* vertices = static_cast<float*>(
         rtcSetNewGeometryBuffer(geometry, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT4,
                                 4 * sizeof(float), 2 * edges.size()));
@@ -571,7 +540,7 @@ class Tracer {
         geometry, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT, sizeof(unsigned), edges.size()));
     if (!vertices || !indices) {
       rtcReleaseGeometry(geometry);
-      check_device(device_.handle, "allocate curves");
+      check_embree(device_.get(), "render", "allocate curves");
       throw Error("render", "Embree could not allocate the edges of " + object_name(k));
     }
     const auto radius = static_cast<float>(prepared.wire_radius);
@@ -590,7 +559,7 @@ class Tracer {
     attach(geometry, k, true);
   }
 
-  Device device_;
+  EmbreeDevice device_{"render"};
   const Camera& camera_;
   const RenderOptions& options_;
   CameraFrame frame_;

@@ -9,8 +9,7 @@
 ///   (OBJ `map_Kd`, sampled bilinearly at the interpolated corner texture coordinates, tiled like
 ///   OBJ; a texel's alpha blends it over the material's `Kd`), the materials' `Kd`, or one colour.
 /// - Optionally the object's polygon edges (not the fan diagonals) as a wireframe overlay. Edges
-/// are
-///   Embree round linear curves (tubes) whose radius is chosen so that they are `wire_width_px`
+///   are Embree round linear curves (tubes) whose radius is chosen so that they are `wire_width_px`
 ///   pixels wide at the distance of the camera target. They are traced in a scene of their own: a
 ///   wire is drawn when it is in front of the surface the ray sees or less than
 ///   `RenderOptions::wire_depth_tolerance` behind it, so a grid lying on (or just under) a surface

@@ -132,15 +132,12 @@ class HermiteProfile {
 // equilateral triangle), i.e. nearly square quads / equilateral triangles everywhere: a conformal
 // spacing, h(s) = c 2 pi r(s) / n. Three limits keep it sensible:
 //  - Near a pole the conformal spacing would need infinitely many rings. From the pole until the
-//  radius
-//    first reaches half the largest radius, r counts as that `pole_radius`: the region around the
-//    pole is meshed uniformly (quad disk, or rings with fewer vertices for triangles).
+//    radius first reaches half the largest radius, r counts as that `pole_radius`: the region
+//    around the pole is meshed uniformly (quad disk, or rings with fewer vertices for triangles).
 //  - Elsewhere radii below a quarter of the largest (`thin_radius`, the goblet's stem) count as
-//  that,
-//    trading faces up to ~2:1 for far fewer rings.
+//    that, trading faces up to ~2:1 for far fewer rings.
 //  - The profile turns by at most min(45 deg, 4 x 2 pi / n) per step (h <= turn / curvature), so
-//  that
-//    tight bends (the goblet's foot edge) get a few rings instead of being cut across.
+//    that tight bends (the goblet's foot edge) get a few rings instead of being cut across.
 //
 // The profile is sampled densely, 1 / h(s) integrated to tau(s) = int ds / h(s), and ring i is put
 // where tau = i * tau_total / m with m = round(tau_total).

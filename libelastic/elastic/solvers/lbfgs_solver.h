@@ -10,7 +10,7 @@
 /// 1. Tangential gradient q = P g (the force the magnet leaves once particles sit on the surface).
 /// 2. Direction p = -H q by the L-BFGS two-loop recursion over the last `memory` pairs (s, y)
 ///    (s: change of the positions, y: change of P g), with the initial inverse Hessian H0 = L^-1,
-///    L the interior spring Laplacian (solver_common.h: 2C per spring plus the angular springs'
+///    L the interior spring Laplacian (spring_laplacian.h: 2C per spring plus the angular springs'
 ///    Gram matrices), applied to the x, y and z coordinates by one algebraic-multigrid V-cycle
 ///    (multigrid.h, default) or an exact sparse LDL^T in nested-dissection order
 ///    (LbfgsOptions::preconditioner). The first step is therefore (about) the Laplacian solve

@@ -91,7 +91,7 @@ struct ExplicitOptions {
 };
 
 /// How the L-BFGS solver applies its initial inverse Hessian H0 ~ L^-1 (L the interior spring
-/// Laplacian, solver_common.h).
+/// Laplacian, spring_laplacian.h).
 enum class Preconditioner {
   Multigrid,  ///< one algebraic-multigrid V-cycle (multigrid.h): O(n) set-up and application; on
               ///< grids of at most MultigridOptions::coarsest_size interior particles it is the

@@ -20,6 +20,7 @@
 #include <utility>
 
 #include "elastic/core/error.h"
+#include "elastic/mesh/mesh_validation.h"
 
 namespace elastic {
 namespace {
@@ -72,45 +73,6 @@ struct Point3 {
     z += w * src.z;
   }
 };
-
-// Ptex-domain geometry: corners of the unit square (Catmull-Clark) and of the unit triangle (Loop),
-// in the order of the control face's corners. Edge k runs from corner k to corner k+1.
-constexpr std::array<std::array<double, 2>, 4> kQuadCorners{{{0, 0}, {1, 0}, {1, 1}, {0, 1}}};
-constexpr std::array<std::array<double, 2>, 3> kTriCorners{{{0, 0}, {1, 0}, {0, 1}}};
-
-Eigen::Vector2d corner_uv(bool triangle, int k) {
-  const auto& c =
-      triangle ? kTriCorners[static_cast<size_t>(k)] : kQuadCorners[static_cast<size_t>(k)];
-  return {c[0], c[1]};
-}
-int num_corners(bool triangle) {
-  return triangle ? 3 : 4;
-}
-/// Point at parameter t along ptex edge k (t = 0 at corner k, t = 1 at corner k+1).
-Eigen::Vector2d edge_point(bool triangle, int k, double t) {
-  const int n = num_corners(triangle);
-  const Eigen::Vector2d a = corner_uv(triangle, k);
-  const Eigen::Vector2d b = corner_uv(triangle, (k + 1) % n);
-  return a + t * (b - a);
-}
-/// Parameter of the projection of uv onto ptex edge k.
-double edge_parameter(bool triangle, int k, const Eigen::Vector2d& uv) {
-  const int n = num_corners(triangle);
-  const Eigen::Vector2d a = corner_uv(triangle, k);
-  const Eigen::Vector2d b = corner_uv(triangle, (k + 1) % n);
-  return (uv - a).dot(b - a) / (b - a).squaredNorm();
-}
-
-Eigen::Vector2d clamp_to_domain(bool triangle, Eigen::Vector2d uv) {
-  uv = uv.cwiseMax(0.0).cwiseMin(1.0);
-  if (triangle) {
-    const double s = uv.x() + uv.y();
-    if (s > 1.0) {
-      uv /= s;  // pull back onto the hypotenuse along the ray from the origin
-    }
-  }
-  return uv;
-}
 
 /// One stretch of a ptex edge and what lies across it: the neighbouring ptex face and the affine
 /// map from this face's (u, v) to the neighbour's. A Catmull-Clark quad next to an n-gon has two
@@ -353,6 +315,7 @@ struct LimitSurface::Impl {
   std::string name;
   SubdivisionScheme scheme = SubdivisionScheme::CatmullClark;
   bool triangle = false;
+  PtexDomain domain{false};  ///< the ptex faces' parameter domain (triangle for Loop)
 
   std::unique_ptr<Far::TopologyRefiner> refiner;
   std::unique_ptr<Far::PatchTable> patch_table;
@@ -371,6 +334,8 @@ struct LimitSurface::Impl {
     throw InvalidInputError(name, problem);
   }
 
+  /// What the limit surface demands of its control mesh (manifold policy of mesh/).
+  static ManifoldRequirements requirements();
   void validate_topology(const LimitSurfaceOptions& options);
   void build_refiner(const LimitSurfaceOptions& options);
   void build_patches(int isolation_level);
@@ -392,96 +357,68 @@ struct LimitSurface::Impl {
 
 // ---------------------------------------------------------------------------------------------
 // Input validation. OpenSubdiv accepts non-manifold topology silently (it tags it and makes it
-// sharp), so edges used by more than two faces, or twice in the same direction, are rejected here.
+// sharp), so the mesh must pass the manifold policy of mesh/ (manifold_problem, its wording too)
+// first; what a limit surface can carry (zero-area faces, several components, unreferenced
+// vertices) is accepted.
+ManifoldRequirements LimitSurface::Impl::requirements() {
+  ManifoldRequirements r;
+  r.allow_several_components = true;
+  r.allow_zero_area_faces = true;
+  r.allow_unreferenced_vertices = true;
+  r.validation.max_examples = 5;
+  return r;
+}
+
 void LimitSurface::Impl::validate_topology(const LimitSurfaceOptions& options) {
   if (options.isolation_level < 1 || options.isolation_level > 10) {
     fail("isolation_level " + std::to_string(options.isolation_level) + " is out of range 1..10");
   }
   const int nv = mesh.num_vertices();
   const int nf = mesh.num_faces();
-  if (nf == 0 || nv == 0) {
-    fail("the mesh is empty (no faces)");
-  }
-  if (static_cast<int>(mesh.face_offsets.size()) != nf + 1 || mesh.face_offsets.front() != 0 ||
-      mesh.face_offsets.back() != static_cast<int>(mesh.face_vertices.size())) {
+  if (nf > 0 &&
+      (static_cast<int>(mesh.face_offsets.size()) != nf + 1 || mesh.face_offsets.front() != 0 ||
+       mesh.face_offsets.back() != static_cast<int>(mesh.face_vertices.size()))) {
     fail("inconsistent face offsets");
   }
-  for (int v = 0; v < nv; ++v) {
-    if (!mesh.positions[static_cast<size_t>(v)].allFinite()) {
-      fail("vertex " + std::to_string(v) + " has a non-finite coordinate");
-    }
+  const ManifoldRequirements required = requirements();
+  const std::string problem =
+      manifold_problem(mesh, validate_mesh(mesh, required.validation), required);
+  if (!problem.empty()) {
+    fail(problem);
   }
-  // Directed edges (a -> b) with their face, sorted, to find each edge's uses.
-  struct Directed {
-    int64_t key;  // min * nv + max
-    int a, b, face;
-  };
-  std::vector<Directed> edges;
+  if (!options.use_creases) {
+    return;
+  }
+  // Undirected edges as sorted keys min * nv + max, to check that creases are edges.
+  std::vector<int64_t> edges;
   edges.reserve(mesh.face_vertices.size());
   for (int f = 0; f < nf; ++f) {
     const auto fv = mesh.face(f);
-    const int n = static_cast<int>(fv.size());
-    if (n < 3) {
-      fail("face " + std::to_string(f) + " has fewer than 3 corners");
-    }
-    for (int i = 0; i < n; ++i) {
-      const int a = fv[static_cast<size_t>(i)];
-      const int b = fv[static_cast<size_t>((i + 1) % n)];
-      if (a < 0 || a >= nv) {
-        fail("face " + std::to_string(f) + " refers to vertex " + std::to_string(a) +
-             ", which does not exist");
-      }
-      for (int j = i + 1; j < n; ++j) {
-        if (fv[static_cast<size_t>(j)] == a) {
-          fail("face " + std::to_string(f) + " uses vertex " + std::to_string(a) + " twice");
-        }
-      }
-      const int64_t key = static_cast<int64_t>(std::min(a, b)) * nv + std::max(a, b);
-      edges.push_back({key, a, b, f});
+    const size_t n = fv.size();
+    for (size_t i = 0; i < n; ++i) {
+      const int a = fv[i], b = fv[(i + 1) % n];
+      edges.push_back(static_cast<int64_t>(std::min(a, b)) * nv + std::max(a, b));
     }
   }
-  std::sort(edges.begin(), edges.end(),
-            [](const Directed& x, const Directed& y) { return x.key < y.key; });
-  for (size_t i = 0; i < edges.size();) {
-    size_t j = i;
-    while (j < edges.size() && edges[j].key == edges[i].key) {
-      ++j;
+  std::sort(edges.begin(), edges.end());
+  for (const Crease& c : mesh.creases) {
+    const int64_t key = static_cast<int64_t>(std::min(c.v0, c.v1)) * nv + std::max(c.v0, c.v1);
+    const bool in_range = c.v0 >= 0 && c.v0 < nv && c.v1 >= 0 && c.v1 < nv;
+    if (!in_range || !std::binary_search(edges.begin(), edges.end(), key)) {
+      fail("crease (" + std::to_string(c.v0) + ", " + std::to_string(c.v1) +
+           ") is not an edge of the mesh");
     }
-    const std::string edge_name =
-        "edge (" + std::to_string(edges[i].a) + ", " + std::to_string(edges[i].b) + ")";
-    if (j - i > 2) {
-      fail("non-manifold topology: " + edge_name + " is used by " + std::to_string(j - i) +
-           " faces");
+    if (!std::isfinite(c.sharpness) || c.sharpness < 0.0) {
+      fail("crease (" + std::to_string(c.v0) + ", " + std::to_string(c.v1) +
+           ") has an invalid sharpness");
     }
-    if (j - i == 2 && edges[i].a == edges[i + 1].a) {
-      fail("inconsistent orientation: " + edge_name +
-           " is traversed in the same direction by faces " + std::to_string(edges[i].face) +
-           " and " + std::to_string(edges[i + 1].face));
-    }
-    i = j;
   }
-  if (options.use_creases) {
-    for (const Crease& c : mesh.creases) {
-      const int64_t key = static_cast<int64_t>(std::min(c.v0, c.v1)) * nv + std::max(c.v0, c.v1);
-      const bool in_range = c.v0 >= 0 && c.v0 < nv && c.v1 >= 0 && c.v1 < nv;
-      const auto it = std::lower_bound(edges.begin(), edges.end(), key,
-                                       [](const Directed& d, int64_t k) { return d.key < k; });
-      if (!in_range || it == edges.end() || it->key != key) {
-        fail("crease (" + std::to_string(c.v0) + ", " + std::to_string(c.v1) +
-             ") is not an edge of the mesh");
-      }
-      if (!std::isfinite(c.sharpness) || c.sharpness < 0.0) {
-        fail("crease (" + std::to_string(c.v0) + ", " + std::to_string(c.v1) +
-             ") has an invalid sharpness");
-      }
+  for (const auto& [v, sharpness] : mesh.corners) {
+    if (v < 0 || v >= nv) {
+      fail("corner tag on vertex " + std::to_string(v) + ", which does not exist");
     }
-    for (const auto& [v, sharpness] : mesh.corners) {
-      if (v < 0 || v >= nv) {
-        fail("corner tag on vertex " + std::to_string(v) + ", which does not exist");
-      }
-      if (!std::isfinite(sharpness) || sharpness < 0.0) {
-        fail("corner tag on vertex " + std::to_string(v) + " has an invalid sharpness");
-      }
+    if (!std::isfinite(sharpness) || sharpness < 0.0) {
+      fail("corner tag on vertex " + std::to_string(v) + " has an invalid sharpness");
     }
   }
 }
@@ -503,6 +440,7 @@ void LimitSurface::Impl::build_refiner(const LimitSurfaceOptions& options) {
       break;
   }
   triangle = scheme == SubdivisionScheme::Loop;
+  domain = PtexDomain(triangle);
 
   std::vector<int> verts_per_face(static_cast<size_t>(mesh.num_faces()));
   for (int f = 0; f < mesh.num_faces(); ++f) {
@@ -550,14 +488,19 @@ void LimitSurface::Impl::build_refiner(const LimitSurfaceOptions& options) {
     fail("OpenSubdiv cannot build the topology" +
          (osd_last_message.empty() ? std::string() : ": " + osd_last_message));
   }
-  // Vertex manifoldness (the faces around a vertex form one fan), which the edge checks do not
-  // cover.
+  // OpenSubdiv's own verdict on vertex manifoldness, a safety net behind the manifold policy
+  // (which already rejects a vertex whose faces form more than one fan), in the policy's words.
   const Far::TopologyLevel& base = refiner->GetLevel(0);
+  MeshValidation flagged;
   for (int v = 0; v < base.GetNumVertices(); ++v) {
     if (base.GetVertexFaces(v).size() > 0 && base.IsVertexNonManifold(v)) {
-      fail("non-manifold topology at vertex " + std::to_string(v) +
-           " (its faces do not form a single fan)");
+      if (flagged.non_manifold_vertices.count++ < requirements().validation.max_examples) {
+        flagged.non_manifold_vertices.examples.push_back(v);
+      }
     }
+  }
+  if (flagged.non_manifold_vertices.count > 0) {
+    fail(manifold_problem(mesh, flagged, requirements()));
   }
 }
 
@@ -754,8 +697,8 @@ void LimitSurface::Impl::build_adjacency() {
     EdgeLink link;
     link.t_end = tb;
     link.face = g;
-    const Eigen::Vector2d pa = edge_point(triangle, k, ta), pb = edge_point(triangle, k, tb);
-    const Eigen::Vector2d qa = edge_point(triangle, m, ua), qb = edge_point(triangle, m, ub);
+    const Eigen::Vector2d pa = domain.edge_point(k, ta), pb = domain.edge_point(k, tb);
+    const Eigen::Vector2d qa = domain.edge_point(m, ua), qb = domain.edge_point(m, ub);
     if (!triangle) {
       // Complex-linear map z -> c z + d with c = (qb - qa) / (pb - pa).
       const std::complex<double> zp(pb.x() - pa.x(), pb.y() - pa.y());
@@ -763,8 +706,8 @@ void LimitSurface::Impl::build_adjacency() {
       const std::complex<double> c = zq / zp;
       link.linear << c.real(), -c.imag(), c.imag(), c.real();
     } else {
-      const Eigen::Vector2d pc = corner_uv(triangle, (k + 2) % 3);
-      const Eigen::Vector2d qd = corner_uv(triangle, (m + 2) % 3);
+      const Eigen::Vector2d pc = domain.corner((k + 2) % 3);
+      const Eigen::Vector2d qd = domain.corner((m + 2) % 3);
       const Eigen::Vector2d qc = qa + qb - qd;  // both edges are whole edges here
       Eigen::Matrix2d from, to;
       from << pb - pa, pc - pa;
@@ -831,7 +774,7 @@ void LimitSurface::Impl::build_adjacency() {
 template <bool kDerivatives>
 void LimitSurface::Impl::evaluate(const SurfacePoint& p, SurfaceDerivatives& out) const {
   check_point(p);
-  const Eigen::Vector2d uv = clamp_to_domain(triangle, p.uv());
+  const Eigen::Vector2d uv = domain.clamp(p.uv());
   const Far::PatchTable::PatchHandle* handle = patch_map->FindPatch(p.face, uv.x(), uv.y());
   if (!handle) {
     throw NumericalError(name, "no patch at ptex face " + std::to_string(p.face));
@@ -1028,13 +971,7 @@ bool LimitSurface::in_domain(const SurfacePoint& p, double tolerance) const {
   if (p.face < 0 || p.face >= num_faces()) {
     return false;
   }
-  if (!(p.u >= -tolerance && p.v >= -tolerance)) {
-    return false;  // also rejects NaN
-  }
-  if (impl_->triangle) {
-    return p.u + p.v <= 1.0 + tolerance;
-  }
-  return p.u <= 1.0 + tolerance && p.v <= 1.0 + tolerance;
+  return impl_->domain.contains(p.uv(), tolerance);  // also rejects NaN
 }
 
 Eigen::Vector3d LimitSurface::position(const SurfacePoint& p) const {
@@ -1104,14 +1041,10 @@ SurfaceCurvature LimitSurface::curvature(const SurfacePoint& p) const {
   const double scale = d.du.norm() * d.dv.norm();
   if (!(d.du.cross(d.dv).norm() > 1e-10 * scale) || !(scale > 0.0)) {
     // At some extraordinary corners the parametrisation is singular (du x dv = 0 while the surface
-    // is smooth). Evaluate a tiny step (1e-6 in ptex units) towards the face centre instead: the
-    // curvature is continuous, so this changes it by O(1e-6) relative.
-    const SurfacePoint c = face_center(p.face);
-    const Eigen::Vector2d dir = (c.uv() - p.uv()).normalized();
-    SurfacePoint q = p;
-    q.u += 1e-6 * dir.x();
-    q.v += 1e-6 * dir.y();
-    d = derivatives(q);
+    // is smooth). Evaluate a tiny step towards the face centre instead (the one nudge,
+    // kSingularNudge of ptex_domain.h): the curvature is continuous, so this changes it by O(1e-6)
+    // relative.
+    d = derivatives(impl_->domain.towards_centre(p, kSingularNudge));
   }
   return curvature(d);
 }
@@ -1125,7 +1058,8 @@ SurfacePoint LimitSurface::walk(const SurfacePoint& from, const Eigen::Vector2d&
   }
   const bool tri = m.triangle;
   int face = from.face;
-  Eigen::Vector2d x = clamp_to_domain(tri, from.uv());
+  const PtexDomain& domain = m.domain;
+  Eigen::Vector2d x = domain.clamp(from.uv());
   Eigen::Vector2d d = delta;
   int count = 0;
   int zero_steps = 0;  // consecutive crossings without progress (circling a vertex)
@@ -1160,20 +1094,20 @@ SurfacePoint LimitSurface::walk(const SurfacePoint& from, const Eigen::Vector2d&
       }
     }
     if (edge < 0 || s_exit >= 1.0) {
-      x = clamp_to_domain(tri, x + d);
+      x = domain.clamp(x + d);
       break;
     }
     const Eigen::Vector2d q = x + s_exit * d;
-    const double t = std::clamp(edge_parameter(tri, edge, q), 0.0, 1.0);
+    const double t = std::clamp(domain.edge_parameter(edge, q), 0.0, 1.0);
     const EdgeLink& link = m.adjacency[static_cast<size_t>(face)].find(edge, t);
-    const Eigen::Vector2d on_edge = edge_point(tri, edge, t);
+    const Eigen::Vector2d on_edge = domain.edge_point(edge, t);
     if (link.face < 0 || zero_steps > 64) {
       x = on_edge;  // the boundary stops the walk (or we gave up circling a vertex)
       break;
     }
     zero_steps = s_exit == 0.0 ? zero_steps + 1 : 0;
     d = link.linear * ((1.0 - s_exit) * d);
-    x = clamp_to_domain(tri, link.linear * on_edge + link.offset);
+    x = domain.clamp(link.linear * on_edge + link.offset);
     face = link.face;
     ++count;
   }
@@ -1188,25 +1122,12 @@ bool LimitSurface::on_boundary(const SurfacePoint& p, double tolerance) const {
     return false;
   }
   const Impl& m = *impl_;
-  const bool tri = m.triangle;
   const Eigen::Vector2d x = p.uv();
-  const int n = num_corners(tri);
-  for (int k = 0; k < n; ++k) {
-    double distance = 0.0;
-    if (tri) {
-      distance = k == 0   ? std::abs(x.y())
-                 : k == 2 ? std::abs(x.x())
-                          : std::abs(1.0 - x.x() - x.y()) / std::sqrt(2.0);
-    } else {
-      distance = k == 0   ? std::abs(x.y())
-                 : k == 1 ? std::abs(1.0 - x.x())
-                 : k == 2 ? std::abs(1.0 - x.y())
-                          : std::abs(x.x());
-    }
-    if (distance > tolerance) {
+  for (int k = 0; k < m.domain.num_corners(); ++k) {
+    if (std::abs(m.domain.inside_distance(k, x)) > tolerance) {
       continue;
     }
-    const double t = std::clamp(edge_parameter(tri, k, x), 0.0, 1.0);
+    const double t = std::clamp(m.domain.edge_parameter(k, x), 0.0, 1.0);
     if (m.adjacency[static_cast<size_t>(p.face)].find(k, t).face < 0) {
       return true;
     }
@@ -1225,7 +1146,7 @@ SurfacePoint LimitSurface::vertex_point(int control_vertex) const {
   }
   const int first = m.control_to_ptex[static_cast<size_t>(f)];
   if (m.triangle || m.mesh.face_size(f) == 4) {
-    const Eigen::Vector2d uv = corner_uv(m.triangle, c);
+    const Eigen::Vector2d uv = m.domain.corner(c);
     return {first, uv.x(), uv.y()};
   }
   return {first + c, 0.0, 0.0};  // an n-gon's sub-face c has the corner vertex at (0, 0)
@@ -1235,10 +1156,8 @@ SurfacePoint LimitSurface::face_center(int ptex_face) const {
   if (ptex_face < 0 || ptex_face >= num_faces()) {
     impl_->fail("ptex face " + std::to_string(ptex_face) + " does not exist");
   }
-  if (impl_->triangle) {
-    return {ptex_face, 1.0 / 3.0, 1.0 / 3.0};
-  }
-  return {ptex_face, 0.5, 0.5};
+  const Eigen::Vector2d c = impl_->domain.centre();
+  return {ptex_face, c.x(), c.y()};
 }
 
 }  // namespace elastic

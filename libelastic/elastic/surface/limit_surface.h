@@ -6,12 +6,11 @@
 ///
 /// - Scheme: Loop for an all-triangle mesh, Catmull-Clark for quad and mixed meshes (overridable).
 /// - Boundaries are interpolated (OpenSubdiv VTX_BOUNDARY_EDGE_AND_CORNER): the limit surface ends
-/// on
-///   the control mesh's boundary curve, and valence-2 boundary corners are sharp.
+///   on the control mesh's boundary curve, and valence-2 boundary corners are sharp.
 /// - Extraordinary vertices are handled by adaptive isolation with Gregory end caps (Gregory
-/// triangles
-///   for Loop): within `isolation_level` rings of refinement the surface is the exact limit, in the
-///   last ring around an extraordinary vertex it is OpenSubdiv's G1 Gregory approximation.
+///   triangles for Loop): within `isolation_level` rings of refinement the surface is the exact
+///   limit, in the last ring around an extraordinary vertex it is OpenSubdiv's G1 Gregory
+///   approximation.
 /// - Creases and corners from the mesh's `creases`/`corners` are applied (when `use_creases`).
 ///
 /// Evaluation: regular patches are bicubic B-splines (Catmull-Clark) or quartic box splines (Loop);
@@ -40,6 +39,7 @@
 #include <vector>
 
 #include "elastic/mesh/polygon_mesh.h"
+#include "elastic/surface/ptex_domain.h"
 #include "elastic/surface/surface_point.h"
 
 namespace elastic {
@@ -90,13 +90,13 @@ struct SurfaceCurvature {
 class LimitSurface {
  public:
   /// Builds the limit surface of `mesh`.
-  /// \throws InvalidInputError naming `options.name` when the mesh is not a valid manifold polygon
-  /// mesh
-  ///         (run validate_mesh first for a full report): no faces, a face with fewer than 3
-  ///         corners or a repeated or out-of-range vertex, a non-finite coordinate, an edge used by
-  ///         more than two faces or twice in the same direction, a vertex whose faces form more
-  ///         than one fan, a crease that is not an edge; or when Loop is forced on a non-triangle
-  ///         mesh, or isolation_level is outside 1..10.
+  /// \throws InvalidInputError naming `options.name` when the mesh is not a valid manifold
+  ///         polygon mesh, worded by manifold_problem() (run validate_mesh first for a full
+  ///         report): no faces, a face with fewer than 3 corners or a repeated or out-of-range
+  ///         vertex, a non-finite coordinate, an edge used by more than two faces or twice in the
+  ///         same direction, a vertex whose faces form more than one fan; or a crease that is not
+  ///         an edge, or when Loop is forced on a non-triangle mesh, or isolation_level is outside
+  ///         1..10. Zero-area faces, several components and unreferenced vertices are accepted.
   explicit LimitSurface(const PolygonMesh& mesh, const LimitSurfaceOptions& options = {});
   ~LimitSurface();
   LimitSurface(LimitSurface&&) noexcept;
@@ -108,6 +108,9 @@ class LimitSurface {
   SubdivisionScheme scheme() const;
   /// True for Loop, where ptex faces are triangles in (u, v).
   bool triangular_domain() const { return scheme() == SubdivisionScheme::Loop; }
+  /// The parameter domain of every ptex face (ptex_domain.h): the unit triangle for Loop, the
+  /// unit square for Catmull-Clark.
+  PtexDomain domain() const { return PtexDomain(triangular_domain()); }
   const std::string& name() const;
 
   /// Number of ptex faces; valid SurfacePoint::face values are 0 .. num_faces()-1.
@@ -128,7 +131,8 @@ class LimitSurface {
   SurfaceDerivatives derivatives(const SurfacePoint& p) const;
   /// Unit normal, principal curvatures and directions, mean and Gaussian curvature.
   /// Where du x dv vanishes (a singular parametrisation at some extraordinary corners), the point
-  /// is nudged 1e-6 (in ptex units) towards the face centre and evaluated there.
+  /// is nudged kSingularNudge (1e-6 ptex units, ptex_domain.h) towards the face centre and
+  /// evaluated there.
   SurfaceCurvature curvature(const SurfacePoint& p) const;
   /// Curvature from already evaluated derivatives (saves an evaluation): the shape operator from
   /// the first and second fundamental forms, expressed in the orthonormal tangent frame (du/|du|, n
@@ -154,8 +158,7 @@ class LimitSurface {
 
   /// Representative SurfacePoint at a control vertex's limit position (in the first face that uses
   /// the vertex; \throws InvalidInputError for a vertex in no face), and at the centre of a ptex
-  /// face
-  /// ((0.5, 0.5), or (1/3, 1/3) for Loop).
+  /// face (PtexDomain::centre(): (0.5, 0.5), or (1/3, 1/3) for Loop).
   SurfacePoint vertex_point(int control_vertex) const;
   SurfacePoint face_center(int ptex_face) const;
 

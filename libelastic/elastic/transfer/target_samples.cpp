@@ -12,6 +12,7 @@
 #include <utility>
 
 #include "elastic/core/error.h"
+#include "elastic/projection/foot_point.h"
 #include "elastic/surface/limit_surface.h"
 
 namespace elastic {
@@ -201,36 +202,14 @@ int levels_for(double length, double limit) {
 
 }  // namespace
 
-TargetSamples sample_target(const Region& region, const Mapping& mapping,
-                            const TargetSamplingOptions& options) {
-  const std::string& name = options.name;
-  if (region.surface == nullptr || region.num_triangles() == 0) {
-    throw InvalidInputError(name, "the target region is empty");
-  }
-  if (!(options.max_edge >= 0.0) || !(options.max_source_edge >= 0.0) ||
-      !std::isfinite(options.max_edge) || !std::isfinite(options.max_source_edge)) {
-    throw InvalidInputError(name, "max_edge and max_source_edge must be finite and >= 0");
-  }
-  if (options.max_levels < 0 || options.max_levels > 12) {
-    throw InvalidInputError(
-        name, "max_levels " + std::to_string(options.max_levels) + " is outside 0..12");
-  }
-  const LimitSurface& surface = *region.surface;
+namespace {
+
+// The refinement levels asked for: from the coarse triangles' 3D edges and (when asked) their
+// images on the source, then more while below min_vertices, fewer when above max_vertices. Sets
+// `limited` when the caps cut the levels asked for.
+int refinement_levels(const Region& region, const Mapping& mapping,
+                      const TargetSamplingOptions& options, bool& limited) {
   const int loop_size = static_cast<int>(region.boundary.size());
-
-  Work w;
-  w.points = region.points;
-  w.lambda.assign(region.points.size(), -1.0);
-  for (int k = 0; k < loop_size; ++k) {
-    w.lambda[static_cast<size_t>(region.boundary[static_cast<size_t>(k)])] = k;
-  }
-  w.triangles = region.triangles;
-  w.face = region.triangle_face;
-  w.uv = region.triangle_uv;
-  w.parent.resize(region.triangles.size());
-  std::iota(w.parent.begin(), w.parent.end(), 0);
-
-  // Levels: from the coarse triangles' 3D edges and (when asked) their images on the source.
   int levels = 0;
   for (const Eigen::Vector3i& t : region.triangles) {
     levels = std::max(levels, levels_for(longest_edge(region.positions, t), options.max_edge));
@@ -254,118 +233,150 @@ TargetSamples sample_target(const Region& region, const Mapping& mapping,
       levels = std::max(levels, levels_for(longest_edge(source, t), options.max_source_edge));
     }
   }
-  TargetSamples out;
   if (levels > options.max_levels) {
     levels = options.max_levels;
-    out.limited = true;
+    limited = true;
   }
-  // Vertex count after each level: V' = V + E, E' = 2E + 3T, T' = 4T (Euler on the disk). More
-  // levels while below min_vertices; fewer when above max_vertices.
-  {
-    long v = static_cast<long>(region.points.size());
-    long t = region.num_triangles();
-    long e = (3 * t + loop_size) / 2;
-    for (int l = 0;; ++l) {
-      const bool wanted = l < levels || (v < options.min_vertices && l < options.max_levels);
-      if (!wanted) {
-        levels = l;
-        break;
+  // Vertex count after each level: V' = V + E, E' = 2E + 3T, T' = 4T (Euler on the disk).
+  long v = static_cast<long>(region.points.size());
+  long t = region.num_triangles();
+  long e = (3 * t + loop_size) / 2;
+  for (int l = 0;; ++l) {
+    const bool wanted = l < levels || (v < options.min_vertices && l < options.max_levels);
+    if (!wanted) {
+      return l;
+    }
+    if (v + e > options.max_vertices) {
+      limited = limited || l < levels;
+      return l;
+    }
+    v += e;
+    e = 2 * e + 3 * t;
+    t *= 4;
+  }
+}
+
+// The region as the first mesh under refinement: boundary vertices at their loop positions.
+Work initial_work(const Region& region) {
+  Work w;
+  w.points = region.points;
+  w.lambda.assign(region.points.size(), -1.0);
+  for (int k = 0; k < static_cast<int>(region.boundary.size()); ++k) {
+    w.lambda[static_cast<size_t>(region.boundary[static_cast<size_t>(k)])] = k;
+  }
+  w.triangles = region.triangles;
+  w.face = region.triangle_face;
+  w.uv = region.triangle_uv;
+  w.parent.resize(region.triangles.size());
+  std::iota(w.parent.begin(), w.parent.end(), 0);
+  return w;
+}
+
+// The sampler's steps over the refined mesh (see sample_target).
+class SourceLocator {
+ public:
+  SourceLocator(const Region& region, const Mapping& mapping, const TargetSamplingOptions& options,
+                const Work& w, TargetSamples& out)
+      : region_(region), mapping_(mapping), options_(options), w_(w), out_(out) {
+    if (options.source_region != nullptr && region.boundary.size() >= 3 &&
+        options.source_region->boundary.size() >= 3) {
+      target_curve_.emplace(region);
+      source_curve_.emplace(*options.source_region);
+    }
+    source_surface_ = options.source_region != nullptr ? options.source_region->surface : nullptr;
+  }
+
+  // Every vertex's limit position, normal and source location (boundary vertices by arc length
+  // on the source curve when it is known, the others by the mapping's inverse).
+  void evaluate_vertices() {
+    const LimitSurface& surface = *region_.surface;
+    const size_t nv = out_.points.size();
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, nv), [&](const tbb::blocked_range<size_t>& r) {
+      for (size_t i = r.begin(); i != r.end(); ++i) {
+        const SurfacePoint& p = out_.points[i];
+        out_.positions[i] = surface.position(p);
+        out_.normals[i] = surface.curvature(p).normal;
+        if (out_.on_boundary[i] && source_curve_ && source_surface_ != nullptr) {
+          // The boundary correspondence of §4.1: same normalised arc length from the anchors.
+          Mapping::Location loc;
+          loc.inside = true;
+          loc.point = source_curve_->at(target_curve_->parameter(w_.lambda[i]));
+          loc.position = source_surface_->position(loc.point);
+          out_.sources[i] = loc;
+        } else {
+          out_.sources[i] = mapping_.inverse(p);
+        }
       }
-      if (v + e > options.max_vertices) {
-        out.limited = out.limited || l < levels;
-        levels = l;
-        break;
+    });
+    if (source_curve_) {
+      for (size_t i = 0; i < nv; ++i) {
+        out_.boundary_by_arc_length += out_.on_boundary[i] ? 1 : 0;
       }
-      v += e;
-      e = 2 * e + 3 * t;
-      t *= 4;
     }
   }
-  for (int l = 0; l < levels; ++l) {
-    split_all(w, loop_size);
-  }
-  out.levels = levels;
 
-  const size_t nv = w.points.size();
-  out.points = std::move(w.points);
-  out.positions.resize(nv);
-  out.normals.resize(nv);
-  out.sources.resize(nv);
-  out.on_boundary.resize(nv);
-  for (size_t i = 0; i < nv; ++i) {
-    out.on_boundary[i] = w.lambda[i] >= 0.0;
+  bool relinearise() const {
+    return source_surface_ != nullptr && options_.source_particles.cols() > 0 &&
+           options_.source_particles.cols() == options_.target_particles.cols();
   }
 
-  std::optional<CurveOnSurface> target_curve, source_curve;
-  if (options.source_region != nullptr && loop_size >= 3 &&
-      options.source_region->boundary.size() >= 3) {
-    target_curve.emplace(region);
-    source_curve.emplace(*options.source_region);
-  }
-  const LimitSurface* source_surface =
-      options.source_region != nullptr ? options.source_region->surface : nullptr;
-
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, nv), [&](const tbb::blocked_range<size_t>& r) {
-    for (size_t i = r.begin(); i != r.end(); ++i) {
-      const SurfacePoint& p = out.points[i];
-      out.positions[i] = surface.position(p);
-      out.normals[i] = surface.curvature(p).normal;
-      if (out.on_boundary[i] && source_curve && source_surface != nullptr) {
-        // The boundary correspondence of §4.1: same normalised arc length from the anchors.
-        Mapping::Location loc;
-        loc.inside = true;
-        loc.point = source_curve->at(target_curve->parameter(w.lambda[i]));
-        loc.position = source_surface->position(loc.point);
-        out.sources[i] = loc;
-      } else {
-        out.sources[i] = mapping.inverse(p);
-      }
-    }
-  });
-  if (source_curve) {
-    for (size_t i = 0; i < nv; ++i) {
-      out.boundary_by_arc_length += out.on_boundary[i] ? 1 : 0;
-    }
-  }
-
-  const bool relinearise = source_surface != nullptr && options.source_particles.cols() > 0 &&
-                           options.source_particles.cols() == options.target_particles.cols();
   // Interior vertices the grid does not cover: with particle positions, the grid triangle of an
   // adjacent covered vertex (the piecewise-linear map extended a little past the grid's edge, see
   // the header); otherwise the inverse of a point nudged towards an adjacent triangle's centroid.
-  std::vector<std::vector<int>> vertex_triangles(nv);
-  for (size_t t = 0; t < w.triangles.size(); ++t) {
-    for (int k = 0; k < 3; ++k) {
-      vertex_triangles[static_cast<size_t>(w.triangles[t][k])].push_back(static_cast<int>(t));
+  void resolve_uncovered() {
+    const size_t nv = out_.points.size();
+    std::vector<std::vector<int>> vertex_triangles(nv);
+    for (size_t t = 0; t < w_.triangles.size(); ++t) {
+      for (int k = 0; k < 3; ++k) {
+        vertex_triangles[static_cast<size_t>(w_.triangles[t][k])].push_back(static_cast<int>(t));
+      }
+    }
+    for (size_t i = 0; i < nv; ++i) {
+      if (out_.sources[i].inside) {
+        continue;
+      }
+      const bool found = (relinearise() && adopt_neighbour(i, vertex_triangles[i])) ||
+                         nudged_inverse(i, vertex_triangles[i]);
+      ++(found ? out_.nudged : out_.unresolved);
     }
   }
-  for (size_t i = 0; i < nv; ++i) {
-    if (out.sources[i].inside) {
-      continue;
+
+  // Piecewise-linear weights in 3D (see the header), then the foot point on the source surface.
+  void relinearise_sources() {
+    if (!relinearise()) {
+      return;
     }
-    bool found = false;
-    if (relinearise) {
-      for (int t : vertex_triangles[i]) {
-        for (int k = 0; k < 3 && !found; ++k) {
-          const Mapping::Location& other =
-              out.sources[static_cast<size_t>(w.triangles[static_cast<size_t>(t)][k])];
-          if (other.inside && other.triangle >= 0) {
-            out.sources[i] = other;
-            found = true;
-          }
-        }
-        if (found) {
-          break;
+    const size_t nv = out_.points.size();
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, nv), [&](const tbb::blocked_range<size_t>& r) {
+      for (size_t i = r.begin(); i != r.end(); ++i) {
+        relinearise_vertex(i);
+      }
+    });
+  }
+
+ private:
+  // Vertex i takes the source location of an adjacent covered vertex that has a grid triangle.
+  bool adopt_neighbour(size_t i, const std::vector<int>& triangles) {
+    for (int t : triangles) {
+      for (int k = 0; k < 3; ++k) {
+        const Mapping::Location& other =
+            out_.sources[static_cast<size_t>(w_.triangles[static_cast<size_t>(t)][k])];
+        if (other.inside && other.triangle >= 0) {
+          out_.sources[i] = other;
+          return true;
         }
       }
     }
+    return false;
+  }
+
+  // The inverse of vertex i moved 10%, 25%, then 50% of the way towards an adjacent triangle's
+  // centroid, in that triangle's ptex face.
+  bool nudged_inverse(size_t i, const std::vector<int>& triangles) {
     for (const double f : {0.1, 0.25, 0.5}) {
-      if (found) {
-        break;
-      }
-      for (int t : vertex_triangles[i]) {
-        const auto& uv = w.uv[static_cast<size_t>(t)];
-        const Eigen::Vector3i& tri = w.triangles[static_cast<size_t>(t)];
+      for (int t : triangles) {
+        const auto& uv = w_.uv[static_cast<size_t>(t)];
+        const Eigen::Vector3i& tri = w_.triangles[static_cast<size_t>(t)];
         Eigen::Vector2d own = uv[0];
         for (int k = 0; k < 3; ++k) {
           if (static_cast<size_t>(tri[k]) == i) {
@@ -375,98 +386,90 @@ TargetSamples sample_target(const Region& region, const Mapping& mapping,
         const Eigen::Vector2d centroid = (uv[0] + uv[1] + uv[2]) / 3.0;
         const Eigen::Vector2d q = (1.0 - f) * own + f * centroid;
         const Mapping::Location loc =
-            mapping.inverse(SurfacePoint{w.face[static_cast<size_t>(t)], q.x(), q.y()});
+            mapping_.inverse(SurfacePoint{w_.face[static_cast<size_t>(t)], q.x(), q.y()});
         if (loc.inside) {
-          out.sources[i] = loc;
-          found = true;
-          break;
+          out_.sources[i] = loc;
+          return true;
         }
-      }
-      if (found) {
-        break;
       }
     }
-    if (found) {
-      ++out.nudged;
-    } else {
-      ++out.unresolved;
+    return false;
+  }
+
+  void relinearise_vertex(size_t i) {
+    const auto& grid_triangles = mapping_.triangles();
+    const Eigen::Matrix3Xd& sp = options_.source_particles;
+    const Eigen::Matrix3Xd& tp = options_.target_particles;
+    Mapping::Location& loc = out_.sources[i];
+    if (!loc.inside || loc.triangle < 0 ||
+        loc.triangle >= static_cast<int>(grid_triangles.size())) {
+      return;
     }
+    const Eigen::Vector3i& tri = grid_triangles[static_cast<size_t>(loc.triangle)];
+    if (tri.maxCoeff() >= tp.cols()) {
+      return;
+    }
+    const Eigen::Vector3d t0 = tp.col(tri[0]);
+    const Eigen::Vector3d e1 = tp.col(tri[1]) - t0, e2 = tp.col(tri[2]) - t0;
+    const Eigen::Vector3d d = out_.positions[i] - t0;
+    // Normal equations of min |b1 e1 + b2 e2 - d|: the projection onto the triangle's plane.
+    const double g11 = e1.dot(e1), g12 = e1.dot(e2), g22 = e2.dot(e2);
+    const double det = g11 * g22 - g12 * g12;
+    if (!(det > 1e-24 * g11 * g22)) {
+      return;  // degenerate particle triangle: keep the inverse
+    }
+    const double r1 = e1.dot(d), r2 = e2.dot(d);
+    const double b1 = (g22 * r1 - g12 * r2) / det, b2 = (g11 * r2 - g12 * r1) / det;
+    const Eigen::Vector3d weights(1.0 - b1 - b2, b1, b2);
+    const Eigen::Vector3d y =
+        weights[0] * sp.col(tri[0]) + weights[1] * sp.col(tri[1]) + weights[2] * sp.col(tri[2]);
+    // The closest point to y from the inverse's answer (already within O(h^2) of it): the foot
+    // point, to a miss of kFootMiss times the particle triangle's size (far below a texel), in at
+    // most kFootSteps steps; where the parameterisation degenerates the point reached is kept.
+    const FootPoint foot = foot_point(*source_surface_, y, loc.point,
+                                      {.tolerance = kFootMiss * std::sqrt(std::max(g11, g22)),
+                                       .max_steps = kFootSteps,
+                                       .stop_at_boundary = false,
+                                       .degenerate_ratio = 0.0});
+    loc.point = foot.point;
+    loc.position = foot.d.position;
+    loc.barycentric = weights;
   }
 
-  // Piecewise-linear weights in 3D (see the header), Gauss-Newton onto the source surface.
-  if (relinearise) {
-    const auto& grid_triangles = mapping.triangles();
-    const Eigen::Matrix3Xd& sp = options.source_particles;
-    const Eigen::Matrix3Xd& tp = options.target_particles;
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, nv), [&](const tbb::blocked_range<size_t>& r) {
-      for (size_t i = r.begin(); i != r.end(); ++i) {
-        Mapping::Location& loc = out.sources[i];
-        if (!loc.inside || loc.triangle < 0 ||
-            loc.triangle >= static_cast<int>(grid_triangles.size())) {
-          continue;
-        }
-        const Eigen::Vector3i& tri = grid_triangles[static_cast<size_t>(loc.triangle)];
-        if (tri.maxCoeff() >= tp.cols()) {
-          continue;
-        }
-        const Eigen::Vector3d t0 = tp.col(tri[0]);
-        const Eigen::Vector3d e1 = tp.col(tri[1]) - t0, e2 = tp.col(tri[2]) - t0;
-        const Eigen::Vector3d d = out.positions[i] - t0;
-        // Normal equations of min |b1 e1 + b2 e2 - d|: the projection onto the triangle's plane.
-        const double g11 = e1.dot(e1), g12 = e1.dot(e2), g22 = e2.dot(e2);
-        const double det = g11 * g22 - g12 * g12;
-        if (!(det > 1e-24 * g11 * g22)) {
-          continue;  // degenerate particle triangle: keep the inverse
-        }
-        const double r1 = e1.dot(d), r2 = e2.dot(d);
-        const double b1 = (g22 * r1 - g12 * r2) / det, b2 = (g11 * r2 - g12 * r1) / det;
-        const Eigen::Vector3d weights(1.0 - b1 - b2, b1, b2);
-        const Eigen::Vector3d y =
-            weights[0] * sp.col(tri[0]) + weights[1] * sp.col(tri[1]) + weights[2] * sp.col(tri[2]);
-        // Closest point to y from the inverse's answer (already within O(h^2) of it): Gauss-Newton
-        // steps in (u, v), walking across ptex edges.
-        SurfacePoint p = loc.point;
-        for (int iteration = 0; iteration < 6; ++iteration) {
-          const SurfaceDerivatives der = source_surface->derivatives(p);
-          const Eigen::Vector3d residual = y - der.position;
-          const double a11 = der.du.dot(der.du), a12 = der.du.dot(der.dv), a22 = der.dv.dot(der.dv);
-          const double adet = a11 * a22 - a12 * a12;
-          if (!(adet > 0.0)) {
-            break;
-          }
-          const double q1 = der.du.dot(residual), q2 = der.dv.dot(residual);
-          const Eigen::Vector2d step((a22 * q1 - a12 * q2) / adet, (a11 * q2 - a12 * q1) / adet);
-          p = source_surface->walk(p, step);
-          if (step.norm() < 1e-14) {
-            break;
-          }
-        }
-        loc.point = p;
-        loc.position = source_surface->position(p);
-        loc.barycentric = weights;
-      }
-    });
-  }
+  static constexpr double kFootMiss = 1e-12;
+  static constexpr int kFootSteps = 6;
 
-  // Boundary loop of the refined mesh: boundary vertices in loop order.
+  const Region& region_;
+  const Mapping& mapping_;
+  const TargetSamplingOptions& options_;
+  const Work& w_;
+  TargetSamples& out_;
+  std::optional<CurveOnSurface> target_curve_, source_curve_;
+  const LimitSurface* source_surface_ = nullptr;
+};
+
+// The refined region's boundary loop: boundary vertices in loop order.
+std::vector<int> boundary_loop(const std::vector<double>& lambda) {
   std::vector<std::pair<double, int>> loop;
-  for (size_t i = 0; i < nv; ++i) {
-    if (w.lambda[i] >= 0.0) {
-      loop.emplace_back(w.lambda[i], static_cast<int>(i));
+  for (size_t i = 0; i < lambda.size(); ++i) {
+    if (lambda[i] >= 0.0) {
+      loop.emplace_back(lambda[i], static_cast<int>(i));
     }
   }
   std::sort(loop.begin(), loop.end());
-  out.boundary.reserve(loop.size());
+  std::vector<int> out;
+  out.reserve(loop.size());
   for (const auto& entry : loop) {
-    out.boundary.push_back(entry.second);
+    out.push_back(entry.second);
   }
+  return out;
+}
 
-  out.triangles = std::move(w.triangles);
-  out.triangle_face = std::move(w.face);
-  out.triangle_uv = std::move(w.uv);
-  out.triangle_parent = std::move(w.parent);
-  std::vector<Eigen::Vector3d> source_positions(nv);
-  for (size_t i = 0; i < nv; ++i) {
+// The longest target edge, and the longest source chord of a triangle whose corners all have a
+// source.
+void measure_edges(TargetSamples& out) {
+  std::vector<Eigen::Vector3d> source_positions(out.sources.size());
+  for (size_t i = 0; i < out.sources.size(); ++i) {
     source_positions[i] = out.sources[i].position;
   }
   for (const Eigen::Vector3i& t : out.triangles) {
@@ -478,6 +481,55 @@ TargetSamples sample_target(const Region& region, const Mapping& mapping,
           std::max(out.max_source_edge_length, longest_edge(source_positions, t));
     }
   }
+}
+
+void check_options(const Region& region, const TargetSamplingOptions& options) {
+  const std::string& name = options.name;
+  if (region.surface == nullptr || region.num_triangles() == 0) {
+    throw InvalidInputError(name, "the target region is empty");
+  }
+  if (!(options.max_edge >= 0.0) || !(options.max_source_edge >= 0.0) ||
+      !std::isfinite(options.max_edge) || !std::isfinite(options.max_source_edge)) {
+    throw InvalidInputError(name, "max_edge and max_source_edge must be finite and >= 0");
+  }
+  if (options.max_levels < 0 || options.max_levels > 12) {
+    throw InvalidInputError(
+        name, "max_levels " + std::to_string(options.max_levels) + " is outside 0..12");
+  }
+}
+
+}  // namespace
+
+TargetSamples sample_target(const Region& region, const Mapping& mapping,
+                            const TargetSamplingOptions& options) {
+  check_options(region, options);
+  TargetSamples out;
+  out.levels = refinement_levels(region, mapping, options, out.limited);
+  Work w = initial_work(region);
+  for (int l = 0; l < out.levels; ++l) {
+    split_all(w, static_cast<int>(region.boundary.size()));
+  }
+
+  const size_t nv = w.points.size();
+  out.points = std::move(w.points);
+  out.positions.resize(nv);
+  out.normals.resize(nv);
+  out.sources.resize(nv);
+  out.on_boundary.resize(nv);
+  for (size_t i = 0; i < nv; ++i) {
+    out.on_boundary[i] = w.lambda[i] >= 0.0;
+  }
+  SourceLocator locator(region, mapping, options, w, out);
+  locator.evaluate_vertices();
+  locator.resolve_uncovered();
+  locator.relinearise_sources();
+
+  out.boundary = boundary_loop(w.lambda);
+  out.triangles = std::move(w.triangles);
+  out.triangle_face = std::move(w.face);
+  out.triangle_uv = std::move(w.uv);
+  out.triangle_parent = std::move(w.parent);
+  measure_edges(out);
   return out;
 }
 
