@@ -11,7 +11,7 @@
 #include <memory>
 #include <vector>
 
-#include "elastic/solvers/multigrid.h"
+#include "elastic/numerics/multigrid.h"
 #include "elastic/solvers/relaxation.h"
 
 namespace elastic::solver_detail {
