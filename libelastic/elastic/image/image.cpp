@@ -68,6 +68,66 @@ std::string stb_reason() {
   return reason != nullptr && *reason != '\0' ? reason : "unknown reason";
 }
 
+/// Checks every Huffman table of a JPEG before stb sees it: a table of more than 256 codes makes
+/// stb_image (the Debian 2022 version) write past its 257-entry size table (found by
+/// tests/fuzz/image_fuzzer.cpp). The file's markers are walked from SOI to EOI; the entropy-coded
+/// data after each SOS is skipped up to the next marker (0xFF not followed by 0x00 or RSTn).
+/// Files that are not JPEG are left alone. \throws InvalidInputError naming the file.
+void check_jpeg_huffman_tables(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  const auto next = [&in]() { return in.get(); };  // EOF: -1
+  if (next() != 0xFF || next() != 0xD8) return;
+  int c = next();
+  while (c != std::char_traits<char>::eof()) {
+    if (c != 0xFF) {
+      c = next();  // stray byte: stb would stop with an error; keep looking for markers
+      continue;
+    }
+    int marker = next();
+    while (marker == 0xFF) marker = next();  // fill bytes
+    if (marker < 0 || marker == 0xD9) return;
+    if (marker == 0x00 || marker == 0x01 || (marker >= 0xD0 && marker <= 0xD8)) {
+      c = next();
+      continue;  // no length: stuffing, TEM, RSTn, SOI
+    }
+    const int high = next(), low = next();
+    if (low < 0) return;
+    long remaining = high * 256L + low - 2;
+    if (remaining < 0) return;
+    if (marker == 0xC4) {
+      while (remaining > 0) {
+        if (next() < 0) return;  // table class and id
+        long codes = 0;
+        for (int i = 0; i < 16; ++i) {
+          const int count = next();
+          if (count < 0) return;
+          codes += count;
+        }
+        if (codes > 256) {
+          throw InvalidInputError(path.string(),
+                                  "not a readable image (corrupt JPEG: a Huffman table of " +
+                                      std::to_string(codes) + " codes, at most 256)");
+        }
+        in.ignore(codes);
+        remaining -= 17 + codes;
+      }
+    } else {
+      in.ignore(remaining);
+    }
+    c = next();
+    if (marker == 0xDA) {
+      // Entropy-coded data up to the next real marker.
+      while (c != std::char_traits<char>::eof()) {
+        if (c == 0xFF) {
+          const int after = in.peek();
+          if (after != 0x00 && !(after >= 0xD0 && after <= 0xD7)) break;
+        }
+        c = next();
+      }
+    }
+  }
+}
+
 }  // namespace
 
 ImageInfo read_image_info(const std::filesystem::path& path, const ImageReadOptions& options) {
@@ -79,6 +139,7 @@ ImageInfo read_image_info(const std::filesystem::path& path, const ImageReadOpti
   if (!std::ifstream(path, std::ios::binary)) {
     throw IoError(name, "cannot open the image");
   }
+  check_jpeg_huffman_tables(path);
   ImageInfo info;
   if (!stbi_info(name.c_str(), &info.width, &info.height, &info.channels) || info.width <= 0 ||
       info.height <= 0) {
