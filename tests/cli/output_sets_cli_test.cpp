@@ -11,8 +11,8 @@
 
 #include <chrono>
 #include <filesystem>
-#include <functional>
 #include <fstream>
+#include <functional>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <sstream>
@@ -35,7 +35,7 @@ struct CliResult {
 /// Runs `elastic args...` (stdout to /dev/null, stderr captured); `kill_when` (if set) is polled
 /// while it runs and the child gets `signal` as soon as it returns true.
 CliResult run(const std::vector<std::string>& args, const fs::path& err_file,
-        const std::function<bool()>& kill_when = {}, int signal = SIGKILL) {
+              const std::function<bool()>& kill_when = {}, int signal = SIGKILL) {
   std::vector<std::string> text = {ELASTIC_CLI};
   text.insert(text.end(), args.begin(), args.end());
   const pid_t pid = ::fork();
@@ -185,14 +185,20 @@ TEST(CliOutputSets, UnwritablePathsAreRefusedBeforeTheWork) {
   const fs::path log = dir / "stderr.txt";
   const fs::path file = dir / "a_file";
   std::ofstream(file) << "not a folder\n";
-  const std::vector<std::string> map = {"map",           "--source",
+  const std::vector<std::string> map = {"map",
+                                        "--source",
                                         test::project_mesh("plane_quads.obj").string(),
-                                        "--source-region", "disk:0,0,0,0.9",
-                                        "--target",      test::project_mesh("cap_quads.obj").string(),
-                                        "--particles",   "5000000",
-                                        "--max-memory",  "100000"};
+                                        "--source-region",
+                                        "disk:0,0,0,0.9",
+                                        "--target",
+                                        test::project_mesh("cap_quads.obj").string(),
+                                        "--particles",
+                                        "5000000",
+                                        "--max-memory",
+                                        "100000"};
   // 5 million particles would take minutes: each refusal below comes first, in well under that.
-  const auto expect_refused = [&](std::vector<std::string> extra, int code, const std::string& names) {
+  const auto expect_refused = [&](std::vector<std::string> extra, int code,
+                                  const std::string& names) {
     std::vector<std::string> args = map;
     args.insert(args.end(), extra.begin(), extra.end());
     const auto start = std::chrono::steady_clock::now();
@@ -233,8 +239,8 @@ TEST(CliOutputSets, MemoryEstimatesRefuseBeforeTheWorkAndNameTheFlag) {
   const std::string cap = test::project_mesh("cap_quads.obj").string();
   // The default limit (at most 4096 MB) refuses 5 million particles on `sample` at once.
   auto start = std::chrono::steady_clock::now();
-  CliResult r = run({"sample", "--mesh", cap, "--region", "disk:0,0,1,0.5", "--particles", "5000000"},
-              log);
+  CliResult r =
+      run({"sample", "--mesh", cap, "--region", "disk:0,0,1,0.5", "--particles", "5000000"}, log);
   EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(10));
   EXPECT_EQ(r.code, 65) << r.err;
   EXPECT_NE(r.err.find("--particles 5000000: needs about"), std::string::npos) << r.err;
@@ -266,11 +272,11 @@ TEST(CliOutputSets, MapSeedReproducesBitForBitAndTwoSeedsDiffer) {
   const fs::path log = dir / "stderr.txt";
   const auto map = [&](const std::string& seed, const std::string& name) {
     const fs::path out = dir / name;
-    const CliResult r = run({"map", "-q", "--source", test::project_mesh("plane_quads.obj").string(),
-                       "--source-region", "disk:0,0,0,0.9", "--target",
-                       test::project_mesh("cap_quads.obj").string(), "--particles", "300",
-                       "--jitter", "0.2", "--seed", seed, "--threads", "1", "--out", out.string()},
-                      log);
+    const CliResult r = run(
+        {"map", "-q", "--source", test::project_mesh("plane_quads.obj").string(), "--source-region",
+         "disk:0,0,0,0.9", "--target", test::project_mesh("cap_quads.obj").string(), "--particles",
+         "300", "--jitter", "0.2", "--seed", seed, "--threads", "1", "--out", out.string()},
+        log);
     EXPECT_EQ(r.code, 0) << r.err;
     return contents(out);
   };
@@ -279,9 +285,9 @@ TEST(CliOutputSets, MapSeedReproducesBitForBitAndTwoSeedsDiffer) {
   EXPECT_EQ(first, again);
   EXPECT_NE(first.at("source_grid.obj"), other.at("source_grid.obj"));
   // A seed without jitter would do nothing: refused, naming both flags.
-  const CliResult r = run({"map", "--source", test::project_mesh("plane_quads.obj").string(), "--target",
-                     test::project_mesh("cap_quads.obj").string(), "--seed", "3"},
-                    log);
+  const CliResult r = run({"map", "--source", test::project_mesh("plane_quads.obj").string(),
+                           "--target", test::project_mesh("cap_quads.obj").string(), "--seed", "3"},
+                          log);
   EXPECT_EQ(r.code, 64) << r.err;
   EXPECT_NE(r.err.find("--seed"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("--jitter"), std::string::npos) << r.err;

@@ -29,7 +29,9 @@ std::string read(const fs::path& p) {
   return s.str();
 }
 
-void write(const fs::path& p, const std::string& text) { std::ofstream(p) << text; }
+void write(const fs::path& p, const std::string& text) {
+  std::ofstream(p) << text;
+}
 
 /// A PID that no process has: a child that has exited and been reaped.
 long dead_pid() {

@@ -136,8 +136,10 @@ void check_memory(double bytes, const std::string& what, long long max_memory_mb
   std::snprintf(text, sizeof text,
                 "needs about %.0f MB of memory, more than the limit of %lld MB%s; raise it with "
                 "--max-memory %.0f",
-                mb, limit, max_memory_mb > 0 ? "" : " (the default: half the physical memory, "
-                                                    "at most 4096 MB)",
+                mb, limit,
+                max_memory_mb > 0 ? ""
+                                  : " (the default: half the physical memory, "
+                                    "at most 4096 MB)",
                 std::ceil(mb * 1.1));
   throw InvalidInputError(what, text);
 }

@@ -38,10 +38,10 @@ ProgressCallback terminal_progress(bool quiet);
 /// Ends the status line (if one was drawn).
 void end_progress_line();
 
-/// Memory estimates, checked before the work starts (docs/cli.md, "Resource limits"). The
-/// per-item costs are peak resident sizes measured with /usr/bin/time on the shipped meshes, rounded
-/// up: `map` about 3.1 KB per particle (grid, springs, solver history, multigrid), `sample` about
-/// 1.0 KB, a paste's painted mesh about 1.0 KB per vertex.
+/// Memory estimates, checked before the work starts (docs/cli.md, "Limits"). The
+/// per-item costs are peak resident sizes measured with /usr/bin/time on the shipped meshes,
+/// rounded up: `map` about 3.1 KB per particle (grid, springs, solver history, multigrid), `sample`
+/// about 1.0 KB, a paste's painted mesh about 1.0 KB per vertex.
 inline constexpr double kMapBytesPerParticle = 3.5e3;
 inline constexpr double kSampleBytesPerParticle = 1.2e3;
 inline constexpr double kPasteBytesPerVertex = 1.2e3;

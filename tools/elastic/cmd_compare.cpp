@@ -2,9 +2,9 @@
 // on one case, on the same particle grid with the same boundary correspondence, measured by the
 // same metrics (docs/metrics.md). JSON report and a Markdown table on stdout.
 #include <iostream>
-#include <optional>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <sstream>
 
 #include "cli_common.h"

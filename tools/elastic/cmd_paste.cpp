@@ -192,8 +192,8 @@ int run_paste(const PasteArgs& a, const CLI::App& sub) {
   // to --min-vertices (to --max-vertices when --max-edge or --texture-resolution drive it).
   MapJob job = a.job;
   const bool refined_by_edges = a.max_edge > 0.0 || a.texture_resolution > 0;
-  job.extra_bytes =
-      kPasteBytesPerVertex * static_cast<double>(refined_by_edges ? a.max_vertices : a.min_vertices);
+  job.extra_bytes = kPasteBytesPerVertex *
+                    static_cast<double>(refined_by_edges ? a.max_vertices : a.min_vertices);
   job.extra_bytes_per_target_face =
       kPasteBytesPerVertex * static_cast<double>(a.resolution) * a.resolution;
   job.extra_what = "--resolution " + std::to_string(a.resolution) +
@@ -412,7 +412,8 @@ int run_paste(const PasteArgs& a, const CLI::App& sub) {
               ? make_decal_mesh(painted, *colors, {.texture_path = stage / "painted_decal.png"})
           : colors ? make_colored_mesh(painted, *colors)
                    : PolygonMesh();
-      if (shown.num_faces() > 0) files.push_back(preview.write_feature(stage / "preview.png", shown));
+      if (shown.num_faces() > 0)
+        files.push_back(preview.write_feature(stage / "preview.png", shown));
       files.push_back(preview.write_grids(stage / "preview_grid.png", grid,
                                           {&result.naive.positions, &result.relaxation.positions},
                                           {"naive map", "ElasticPaint"}));

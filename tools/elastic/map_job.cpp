@@ -160,9 +160,9 @@ std::unique_ptr<MapSession> run_map_job(const MapJob& job, const ProgressCallbac
   // The map's memory, from the final particle count (each --subdivide level quadruples it).
   const double final_particles = static_cast<double>(job.particles) * std::pow(4.0, job.subdivide);
   const double map_bytes = kBaseBytes + kMapBytesPerParticle * final_particles;
-  const std::string map_what = "--particles " + std::to_string(job.particles) +
-                               (job.subdivide > 0 ? " --subdivide " + std::to_string(job.subdivide)
-                                                  : std::string());
+  const std::string map_what =
+      "--particles " + std::to_string(job.particles) +
+      (job.subdivide > 0 ? " --subdivide " + std::to_string(job.subdivide) : std::string());
   check_memory(map_bytes, map_what, job.max_memory_mb);
   auto session = std::make_unique<MapSession>();
   MapSession& s = *session;

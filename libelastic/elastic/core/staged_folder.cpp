@@ -148,7 +148,9 @@ std::string hidden_prefix(const fs::path& destination, const char* kind) {
 std::string staging_prefix(const fs::path& destination) {
   return hidden_prefix(destination, ".staging.");
 }
-std::string old_prefix(const fs::path& destination) { return hidden_prefix(destination, ".old."); }
+std::string old_prefix(const fs::path& destination) {
+  return hidden_prefix(destination, ".old.");
+}
 
 /// Brings every entry of `from` that `to` lacks into `to`: folders recursively, files as hard
 /// links (copies when a link fails, e.g. across file systems), symbolic links as links.
@@ -205,16 +207,17 @@ StagedFolder::StagedFolder(fs::path destination, std::string name) : name_(std::
   const fs::path parent = destination_.parent_path();
   fs::create_directories(parent, ec);
   if (ec) {
-    throw IoError(shown, "cannot create the folder " + parent.string() + " (" + name_ +
-                             "): " + ec.message(),
-                  IoError::Direction::Write);
+    throw IoError(
+        shown, "cannot create the folder " + parent.string() + " (" + name_ + "): " + ec.message(),
+        IoError::Direction::Write);
   }
   remove_stale_staging(destination_);
   staging_ = parent / (staging_prefix(destination_) + std::to_string(::getpid()));
   fs::remove_all(staging_, ec);
   if (!fs::create_directory(staging_, ec) || ec) {
-    throw IoError(shown, "cannot write into " + parent.string() + " (" + name_ + "): " +
-                             (ec ? ec.message() : std::string("the staging folder exists")),
+    throw IoError(shown,
+                  "cannot write into " + parent.string() + " (" + name_ +
+                      "): " + (ec ? ec.message() : std::string("the staging folder exists")),
                   IoError::Direction::Write);
   }
   slot_ = registry().add(staging_.string());
@@ -248,8 +251,8 @@ void StagedFolder::commit() {
       throw IoError(shown, "cannot carry its other files into the new set: " + e.code().message(),
                     IoError::Direction::Write);
     }
-    if (::renameat2(AT_FDCWD, staging_.c_str(), AT_FDCWD, destination_.c_str(),
-                    RENAME_EXCHANGE) != 0) {
+    if (::renameat2(AT_FDCWD, staging_.c_str(), AT_FDCWD, destination_.c_str(), RENAME_EXCHANGE) !=
+        0) {
       const int error = errno;
       if (error != EINVAL && error != ENOSYS && error != ENOTSUP) {
         fail("cannot move the new set into place", error);
@@ -290,8 +293,8 @@ int remove_stale_staging(const fs::path& destination) noexcept {
   int count = 0;
   try {
     std::error_code ec;
-    const fs::path parent = destination.parent_path().empty() ? fs::path(".")
-                                                              : destination.parent_path();
+    const fs::path parent =
+        destination.parent_path().empty() ? fs::path(".") : destination.parent_path();
     const std::string staging = staging_prefix(destination);
     const std::string old = old_prefix(destination);
     for (const fs::directory_entry& entry : fs::directory_iterator(parent, ec)) {
@@ -322,8 +325,7 @@ void check_output_file(const fs::path& path, const std::string& name) {
   }
   const fs::path folder = absolute.parent_path();
   if (!fs::is_directory(folder, ec)) {
-    throw IoError(path.string(),
-                  "the folder " + folder.string() + " does not exist (" + name + ")",
+    throw IoError(path.string(), "the folder " + folder.string() + " does not exist (" + name + ")",
                   IoError::Direction::Write);
   }
   if (::access(folder.c_str(), W_OK) != 0) {

@@ -73,11 +73,11 @@ std::string stb_reason() {
 /// tests/fuzz/image_fuzzer.cpp, three times with three ways around a marker walk). So the check
 /// does not follow stb's parsing: in a file that starts like a JPEG (0xFF, fill bytes, SOI), every
 /// DHT marker bytes 0xFF 0xC4 anywhere is read as stb would read a DHT segment there (tables of a
-/// class byte and 16 counts, missing bytes as zeros, while the segment's length lasts). A valid JPEG
-/// has these bytes only at its DHT segments (entropy-coded data stuffs every 0xFF), so it passes;
-/// a file with them inside other data (e.g. an ICC profile) is checked there too, and refused only
-/// if the bytes after them would be a table that overflows stb. \throws InvalidInputError naming
-/// the file.
+/// class byte and 16 counts, missing bytes as zeros, while the segment's length lasts). A valid
+/// JPEG has these bytes only at its DHT segments (entropy-coded data stuffs every 0xFF), so it
+/// passes; a file with them inside other data (e.g. an ICC profile) is checked there too, and
+/// refused only if the bytes after them would be a table that overflows stb. \throws
+/// InvalidInputError naming the file.
 void check_jpeg_huffman_tables(const std::filesystem::path& path) {
   std::ifstream in(path, std::ios::binary);
   const auto next = [&in]() { return in.get(); };  // EOF: -1

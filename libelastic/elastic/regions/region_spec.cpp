@@ -24,7 +24,6 @@ using regions_detail::PatchTopology;
 /// a vertex or an edge are moved onto it, so that cutting never leaves sliver triangles.
 constexpr double kSnap = 1e-3;
 
-
 /// Everything make_region needs about the surface's tessellation.
 struct Context {
   const SurfaceProjector& projector;
@@ -519,7 +518,6 @@ double automatic_anchor(const Region& region) {
 }
 
 }  // namespace
-
 
 Region make_region(const SurfaceProjector& projector, const RegionSpec& spec,
                    const RegionOptions& options) {
