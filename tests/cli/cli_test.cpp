@@ -124,7 +124,7 @@ TEST(Cli, JobFileRepeatsTheRunAndFlagsWin) {
   const std::string report = (dir / "first.json").string();
   const CliRun first = elastic(
       "map --source " + mesh("plane_quads.obj") + " --source-region disk:0,0,0,0.8 --target " +
-          mesh("cap_quads.obj") + " --particles 150 --seed 3 --report " + report,
+          mesh("cap_quads.obj") + " --particles 150 --jitter 0.1 --seed 3 --report " + report,
       dir);
   ASSERT_EQ(first.code, 0) << first.err;
   // Nothing but results in a pipe: no progress line on stderr.

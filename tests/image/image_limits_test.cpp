@@ -90,5 +90,26 @@ TEST(ImageLimits, LimitIsInclusiveAndMustBePositive) {
   EXPECT_EQ(kDefaultMaxImagePixels, std::int64_t{8192} * 8192);
 }
 
+// JPEGs found by tests/fuzz/image_fuzzer.cpp: a Huffman table of more than 256 codes (4080, and
+// one cut short by the end of the file) made stb_image write past its 257-entry table. Refused by
+// name before stb sees them; a good JPEG of the same corpus still reads.
+TEST(ImageLimits, JpegHuffmanTablesOfMoreThan256CodesAreRefused) {
+  const fs::path corpus = fs::path(ELASTIC_MESHES_DIR).parent_path() / "tests/fuzz/corpus/image";
+  for (const char* name :
+       {"jpeg_huffman_table_of_4080_codes.jpg", "jpeg_huffman_table_cut_short.jpg",
+        "jpeg_huffman_table_after_fill_bytes.jpg"}) {
+    try {
+      read_image(corpus / name);
+      FAIL() << name << " was read";
+    } catch (const InvalidInputError& e) {
+      EXPECT_NE(std::string(e.what()).find(name), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("Huffman table"), std::string::npos) << e.what();
+    }
+  }
+  const Image good = read_image(corpus / "rgb_5x3.jpg");
+  EXPECT_EQ(good.width, 5);
+  EXPECT_EQ(good.height, 3);
+}
+
 }  // namespace
 }  // namespace elastic

@@ -122,6 +122,31 @@ void end_progress_line() {
   }
 }
 
+long long default_max_memory_mb() {
+  const long pages = ::sysconf(_SC_PHYS_PAGES);
+  const long page_size = ::sysconf(_SC_PAGESIZE);
+  constexpr long long kMostDefault = 4096;
+  if (pages <= 0 || page_size <= 0) return kMostDefault;
+  const long long half = static_cast<long long>(pages) / 2 * page_size / (1024 * 1024);
+  return std::clamp(half, 1LL, kMostDefault);
+}
+
+void check_memory(double bytes, const std::string& what, long long max_memory_mb) {
+  const long long limit = max_memory_mb > 0 ? max_memory_mb : default_max_memory_mb();
+  const double mb = bytes / (1024.0 * 1024.0);
+  if (mb <= static_cast<double>(limit)) return;
+  char text[256];
+  std::snprintf(text, sizeof text,
+                "needs about %.0f MB of memory, more than the limit of %lld MB%s; raise it with "
+                "--max-memory %.0f",
+                mb, limit,
+                max_memory_mb > 0 ? ""
+                                  : " (the default: half the physical memory, "
+                                    "at most 4096 MB)",
+                std::ceil(mb * 1.1));
+  throw InvalidInputError(what, text);
+}
+
 void print_warnings(const std::vector<std::string>& warnings, bool quiet) {
   if (quiet) return;
   for (const std::string& w : warnings) std::cerr << "elastic: warning: " << w << '\n';

@@ -39,6 +39,24 @@ ProgressCallback terminal_progress(bool quiet);
 /// Ends the status line (if one was drawn).
 void end_progress_line();
 
+/// Memory estimates, checked before the work starts (docs/cli.md, "Limits"). The
+/// per-item costs are peak resident sizes measured with /usr/bin/time on the shipped meshes,
+/// rounded up: `map` about 3.1 KB per particle (grid, springs, solver history, multigrid), `sample`
+/// about 1.0 KB, a paste's painted mesh about 1.0 KB per vertex.
+inline constexpr double kMapBytesPerParticle = 3.5e3;
+inline constexpr double kSampleBytesPerParticle = 1.2e3;
+inline constexpr double kPasteBytesPerVertex = 1.2e3;
+inline constexpr double kBaseBytes = 64e6;  ///< the tool, the meshes and their limit surfaces
+
+/// The default of --max-memory, in MB: half the physical memory, at most 4096 (so that a run
+/// that would take minutes and gigabytes is refused in a moment unless asked for).
+long long default_max_memory_mb();
+
+/// Throws InvalidInputError naming `what` (e.g. "--particles 5000000") when `bytes` is over
+/// `max_memory_mb` (0: default_max_memory_mb()), giving the estimate, the limit and the flag that
+/// raises it (--max-memory).
+void check_memory(double bytes, const std::string& what, long long max_memory_mb);
+
 /// Prints warnings to stderr ("elastic: warning: ...") unless quiet.
 void print_warnings(const std::vector<std::string>& warnings, bool quiet);
 

@@ -4,12 +4,14 @@
 #include <iostream>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <sstream>
 
 #include "cli_common.h"
 #include "command.h"
 #include "compare_methods.h"
 #include "elastic/core/error.h"
+#include "elastic/core/staged_folder.h"
 #include "job_file.h"
 #include "map_job.h"
 #include "verdict.h"
@@ -43,18 +45,25 @@ std::vector<BaselineKind> parse_baselines(const std::string& text) {
 int run_compare(const CompareArgs& args, const CLI::App& sub) {
   CompareOptions options;
   options.baselines = parse_baselines(args.baselines);
-  options.heatmap_dir = args.heatmap_dir;
   try {
     options.heatmap.metric = parse_triangle_metric(args.heatmap_metric, "--heatmap-metric");
   } catch (const InvalidInputError& e) {
     throw UsageError(e.what());
   }
   options.heatmap.percentile = args.heatmap_percentile;
+  // Output paths are checked before any work; the heatmaps appear together (staged_folder.h).
+  if (!args.job.report.empty()) check_output_file(args.job.report, "--report");
+  std::optional<StagedFolder> heatmaps;
+  if (!args.heatmap_dir.empty()) {
+    heatmaps.emplace(args.heatmap_dir, "--heatmap");
+    options.heatmap_dir = heatmaps->staging();
+  }
 
   const std::unique_ptr<MapSession> session =
       run_map_job(args.job, terminal_progress(args.job.quiet));
   end_progress_line();
   const std::vector<MethodMeasurement> methods = compare_methods(*session, options);
+  if (heatmaps) heatmaps->commit();
 
   const nlohmann::json job = recorded_job(args.job, job_of(sub));
   const MapVerdict verdict = judge_map(args.job, *session);

@@ -5,11 +5,13 @@
 #include <fstream>
 #include <iostream>
 #include <nlohmann/json.hpp>
+#include <optional>
 
 #include "cli_common.h"
 #include "command.h"
 #include "elastic/core/atomic_file.h"
 #include "elastic/core/error.h"
+#include "elastic/core/staged_folder.h"
 #include "elastic/mapping/map_regions.h"
 #include "elastic/mesh/mesh_io.h"
 #include "job_file.h"
@@ -25,18 +27,22 @@ struct MapArgs {
 };
 
 int run_map(const MapArgs& args, const CLI::App& sub) {
+  // Output paths are checked before any work; the grids appear together (staged_folder.h).
+  if (!args.job.report.empty()) check_output_file(args.job.report, "--report");
+  std::optional<StagedFolder> out;
+  if (!args.out.empty()) out.emplace(args.out, "--out");
   const std::unique_ptr<MapSession> session =
       run_map_job(args.job, terminal_progress(args.job.quiet));
   end_progress_line();
   const MapResult& result = session->result;
   const nlohmann::json report = map_report(args.job, *session, job_of(sub));
-  if (!args.out.empty()) {
-    const std::filesystem::path dir(args.out);
-    std::filesystem::create_directories(dir);
+  if (out) {
+    const std::filesystem::path& dir = out->staging();
     const ParticleGrid& grid = result.sampling.grid;
     write_mesh(dir / "source_grid.obj", to_polygon_mesh(grid, grid.source_positions()));
     write_mesh(dir / "naive_grid.obj", to_polygon_mesh(grid, result.naive.positions));
     write_mesh(dir / "target_grid.obj", to_polygon_mesh(grid, result.relaxation.positions));
+    out->commit();
   }
   write_report(args.job.report, report);
   print_map_summary(args.job, *session);

@@ -13,6 +13,7 @@
 #include "command.h"
 #include "compare_methods.h"
 #include "elastic/core/error.h"
+#include "elastic/core/staged_folder.h"
 #include "elastic/image/image.h"
 #include "elastic/mesh/mesh_io.h"
 #include "elastic/metrics/heatmap.h"
@@ -73,24 +74,6 @@ bool same_file(const std::filesystem::path& a, const std::filesystem::path& b) {
     return std::filesystem::equivalent(a, b, ec);
   }
   return std::filesystem::weakly_canonical(a, ec) == std::filesystem::weakly_canonical(b, ec);
-}
-
-// The output folder exists and accepts a file, checked before the (long) map runs.
-void check_output_folder(const std::filesystem::path& dir) {
-  std::error_code ec;
-  std::filesystem::create_directories(dir, ec);
-  if (ec) {
-    throw IoError(dir.string(), "cannot create the output folder: " + ec.message(),
-                  IoError::Direction::Write);
-  }
-  const std::filesystem::path probe = dir / ".elastic_paste_probe";
-  {
-    std::ofstream out(probe);
-    if (!out) {
-      throw IoError(dir.string(), "the output folder is not writable", IoError::Direction::Write);
-    }
-  }
-  std::filesystem::remove(probe, ec);
 }
 
 // Checks that need only the input files, before mapping: a colour source that exists, a target
@@ -194,7 +177,30 @@ int run_paste(const PasteArgs& a, const CLI::App& sub) {
   const auto start = std::chrono::steady_clock::now();
   const std::filesystem::path dir(a.out);
   check_inputs(a);
-  check_output_folder(dir);
+  // Every path is checked before any work. The files go to a staging folder beside --out and
+  // appear there together at the end (core/staged_folder.h); a --report inside --out is part of
+  // the set, one elsewhere is written after it.
+  StagedFolder staged(dir, "--out");
+  const std::filesystem::path stage = staged.staging();
+  std::filesystem::path report_path = stage / "report.json";
+  if (!a.job.report.empty()) {
+    const std::filesystem::path wanted = std::filesystem::absolute(a.job.report).lexically_normal();
+    report_path = wanted.parent_path() == staged.destination() ? stage / wanted.filename() : wanted;
+    if (report_path == wanted) check_output_file(a.job.report, "--report");
+  }
+
+  // The painted mesh's memory, checked with the map's before the map runs: the target
+  // tessellated at --resolution (resolution^2 vertices per control face), and the region refined
+  // to --min-vertices (to --max-vertices when --max-edge or --texture-resolution drive it).
+  MapJob job = a.job;
+  const bool refined_by_edges = a.max_edge > 0.0 || a.texture_resolution > 0;
+  job.extra_bytes = kPasteBytesPerVertex *
+                    static_cast<double>(refined_by_edges ? a.max_vertices : a.min_vertices);
+  job.extra_bytes_per_target_face =
+      kPasteBytesPerVertex * static_cast<double>(a.resolution) * a.resolution;
+  job.extra_what = "--resolution " + std::to_string(a.resolution) +
+                   (refined_by_edges ? " --max-vertices " + std::to_string(a.max_vertices)
+                                     : " --min-vertices " + std::to_string(a.min_vertices));
 
   // Relaxation frames for the preview's animation (positions every --frames iterations).
   std::vector<Eigen::Matrix3Xd> frames;
@@ -210,7 +216,7 @@ int run_paste(const PasteArgs& a, const CLI::App& sub) {
     };
   }
   const std::unique_ptr<MapSession> session =
-      run_map_job(a.job, terminal_progress(a.job.quiet), frame, a.frames);
+      run_map_job(job, terminal_progress(a.job.quiet), frame, a.frames);
   end_progress_line();
   const MapResult& result = session->result;
   const LimitSurface& source = *session->source.surface;
@@ -218,7 +224,7 @@ int run_paste(const PasteArgs& a, const CLI::App& sub) {
   nlohmann::json report = map_report(a.job, *session, job_of(sub));
   // Every file the paste writes goes through the folder, which keeps it self-contained: textures
   // are copied in and referenced by bare names, every OBJ face has a material.
-  OutputFolder folder(dir);
+  OutputFolder folder(stage);
   std::vector<std::filesystem::path> files;
 
   const std::optional<ColorSource> colors = make_color_source(a, source);
@@ -409,7 +415,7 @@ int run_paste(const PasteArgs& a, const CLI::App& sub) {
     if (a.preview) {
       PolygonMesh shown =
           colors && colors->kind() == ColorSourceKind::Texture
-              ? make_decal_mesh(painted, *colors, {.texture_path = dir / "painted_decal.png"})
+              ? make_decal_mesh(painted, *colors, {.texture_path = stage / "painted_decal.png"})
           : colors ? make_colored_mesh(painted, *colors)
                    : PolygonMesh();
       // A height paste is shown displaced: the relief appears as shading, in preview.png under
@@ -417,14 +423,14 @@ int run_paste(const PasteArgs& a, const CLI::App& sub) {
       if (!displaced.empty() && shown.positions.size() == displaced.size()) {
         shown.positions = displaced;
       }
-      if (shown.num_faces() > 0) files.push_back(preview.write_feature(dir / "preview.png", shown));
+      if (shown.num_faces() > 0) files.push_back(preview.write_feature(stage / "preview.png", shown));
       if (!displaced.empty()) {
         PolygonMesh relief;
         relief.positions = displaced;
         for (const Eigen::Vector3i& c : painted.triangles) relief.add_face({c[0], c[1], c[2]});
-        files.push_back(preview.write_feature(dir / "preview_height.png", relief));
+        files.push_back(preview.write_feature(stage / "preview_height.png", relief));
       }
-      files.push_back(preview.write_grids(dir / "preview_grid.png", grid,
+      files.push_back(preview.write_grids(stage / "preview_grid.png", grid,
                                           {&result.naive.positions, &result.relaxation.positions},
                                           {"naive map", "ElasticPaint"}));
       std::vector<const Eigen::Matrix3Xd*> positions;
@@ -437,24 +443,32 @@ int run_paste(const PasteArgs& a, const CLI::App& sub) {
         labels.push_back(m.name == "elastic" ? "ElasticPaint" : m.name);
       }
       if (!positions.empty()) {
-        files.push_back(preview.write_heatmaps(dir / "preview_heatmap.png", positions, measured,
+        files.push_back(preview.write_heatmaps(stage / "preview_heatmap.png", positions, measured,
                                                labels, heat_scale));
       }
     }
     if (!frames.empty()) {
-      for (const auto& f : preview.write_frames(dir / "frames", grid, frames, frame_iterations)) {
+      for (const auto& f : preview.write_frames(stage / "frames", grid, frames, frame_iterations)) {
         files.push_back(f);
       }
     }
   }
+  // The report names the files where they will be (the set is moved into place below).
+  for (auto& f : files) f = dir / staged.final_path(f).lexically_relative(staged.destination());
   nlohmann::json list = nlohmann::json::array();
   for (const auto& f : files) list.push_back(f.string());
   report["files"] = list;
   if (!folder.warnings().empty()) report["paste"]["warnings"] = folder.warnings();
   print_warnings(folder.warnings(), a.job.quiet);
-  const std::string report_path =
-      a.job.report.empty() ? (dir / "report.json").string() : a.job.report;
-  write_report(report_path, report);
+  const bool report_in_set = report_path.parent_path() == stage;
+  if (report_in_set) write_report(report_path.string(), report);
+  staged.commit();
+  if (report_in_set) {
+    report_path = a.job.report.empty() ? dir / "report.json" : std::filesystem::path(a.job.report);
+  } else {
+    write_report(report_path.string(), report);
+    report_path = a.job.report;
+  }
 
   print_map_summary(a.job, *session);
   if (!a.job.quiet) {
@@ -463,7 +477,7 @@ int run_paste(const PasteArgs& a, const CLI::App& sub) {
               << std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()
               << " s\n";
     for (const auto& f : files) std::cout << "  wrote " << f.string() << '\n';
-    std::cout << "  report " << report_path << '\n';
+    std::cout << "  report " << report_path.string() << '\n';
   }
   // The headline: distortion against the baseline on the same grid.
   for (const MethodMeasurement& m : methods) {

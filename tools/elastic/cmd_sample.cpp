@@ -8,6 +8,7 @@
 #include "cli_common.h"
 #include "command.h"
 #include "elastic/core/atomic_file.h"
+#include "elastic/core/staged_folder.h"
 #include "elastic/mesh/mesh_io.h"
 #include "elastic/regions/region_spec.h"
 #include "elastic/sampling/sample_region.h"
@@ -33,11 +34,17 @@ struct SampleArgs {
   std::string out;
   std::string report;
   bool quiet = false;
+  long long max_memory_mb = 0;  // --max-memory MB (0: default_max_memory_mb())
 };
 
 int run_sample(const SampleArgs& args, const CLI::App& sub) {
   require_flag(args.mesh, "--source");
   require_flag(args.region, "--source-region");
+  check_memory(kBaseBytes + kSampleBytesPerParticle * static_cast<double>(args.particles),
+               "--particles " + std::to_string(args.particles), args.max_memory_mb);
+  // Output paths are checked before any work.
+  if (!args.out.empty()) check_output_file(args.out, "--out");
+  if (!args.report.empty()) check_output_file(args.report, "--report");
   LoadedSurface loaded = load_surface(args.mesh, args.scheme);
   print_warnings(loaded.warnings, args.quiet);
   RegionOptions region_options;
@@ -155,6 +162,10 @@ ELASTIC_COMMAND("sample", "Sample a source region with the particle grid", [](CL
       ->check(CLI::IsMember({"auto", "loop", "catmull-clark"}));
   sub.add_option("--out", args->out, "Write the grid (particles and springs' faces): .obj or .ply");
   sub.add_option("--report", args->report, "Write the statistics as JSON");
+  sub.add_option("--max-memory", args->max_memory_mb,
+                 "Refuse runs estimated to need more memory, in MB (0: half the physical memory, "
+                 "at most 4096), checked before any work")
+      ->check(CLI::NonNegativeNumber);
   sub.add_flag("-q,--quiet", args->quiet, "No progress line or warnings");
   sub.footer(
       "Example:\n  elastic sample --source cap.obj --source-region disk:0,0,1,0.5 --particles 5000 "

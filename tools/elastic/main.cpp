@@ -12,16 +12,18 @@
 #include "command.h"
 #include "elastic/core/atomic_file.h"
 #include "elastic/core/error.h"
+#include "elastic/core/staged_folder.h"
 #include "job_file.h"
 
 namespace {
 
-/// On SIGINT, SIGTERM or SIGHUP: remove the temporary files being written (async-signal-safe),
-/// then die of the same signal, so the parent sees the usual status. Finished files are never
-/// touched: each was renamed into place whole, and every destination keeps its old content until
-/// its rename.
+/// On SIGINT, SIGTERM or SIGHUP: remove the temporary files and the uncommitted staging folders
+/// being written (async-signal-safe), then die of the same signal, so the parent sees the usual
+/// status. Finished files are never touched: each was renamed into place whole, and every
+/// destination keeps its old content until its rename.
 extern "C" void remove_temporaries_and_reraise(int signal_number) {
   elastic::remove_temporary_files_now();
+  elastic::remove_staging_folders_now();
   ::signal(signal_number, SIG_DFL);
   ::raise(signal_number);
 }

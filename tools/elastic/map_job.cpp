@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <fstream>
 #include <iostream>
 #include <sstream>
@@ -102,8 +103,16 @@ void add_map_flags(CLI::App& sub, MapJob& a) {
                  "Refine the particle grid K times after the map and relax briefly (end of §4.3)")
       ->check(CLI::Range(0, 4));
   sub.add_option("--threads", a.threads, "Threads (0: all)")->check(CLI::Range(0, 1024));
-  sub.add_option("--seed", a.seed, "Seed of the sampling's random jitter");
+  sub.add_option("--jitter", a.jitter,
+                 "Random initial displacement of the sampling's particles, fraction of the "
+                 "spacing (0: none, the sampling is deterministic)")
+      ->check(CLI::Range(0.0, 0.5));
+  sub.add_option("--seed", a.seed, "Seed of the --jitter (the same seed repeats a run exactly)");
   sub.add_option("--max-iterations", a.max_iterations, "Solver iteration budget (0: default)")
+      ->check(CLI::NonNegativeNumber);
+  sub.add_option("--max-memory", a.max_memory_mb,
+                 "Refuse runs estimated to need more memory, in MB (0: half the physical memory, "
+                 "at most 4096), checked before any work")
       ->check(CLI::NonNegativeNumber);
   sub.add_option("--report", a.report, "Write the JSON report to this file");
   sub.add_flag("--quiet,-q", a.quiet, "No progress, no warnings: only results");
@@ -114,6 +123,7 @@ MapOptions make_map_options(const MapJob& job, const ProgressCallback& progress)
   options.sampling.layout.particles = job.particles;
   options.sampling.layout.name = "--source-region";
   options.sampling.sampling.seed = job.seed;
+  options.sampling.sampling.jitter = job.jitter;
   options.rest_scale = parse_rest_scale(job.rest_scale, "--rest-scale");
   options.relaxation.solver = job.solver == "explicit" ? SolverKind::Faithful : SolverKind::Fast;
   options.relaxation.energy = parse_energy_kind(job.energy, "--energy");
@@ -139,9 +149,19 @@ std::unique_ptr<MapSession> run_map_job(const MapJob& job, const ProgressCallbac
   const auto start = std::chrono::steady_clock::now();
   require_flag(job.target, "--target");
   check_particles(job.particles);
+  if (job.seed != 0 && job.jitter == 0.0) {
+    throw UsageError("--seed chooses the random start of --jitter, which is 0: give --jitter F");
+  }
   if (job.source.empty() == job.source_image.empty()) {
     throw UsageError("give exactly one of --source MESH and --source-image IMAGE");
   }
+  // The map's memory, from the final particle count (each --subdivide level quadruples it).
+  const double final_particles = static_cast<double>(job.particles) * std::pow(4.0, job.subdivide);
+  const double map_bytes = kBaseBytes + kMapBytesPerParticle * final_particles;
+  const std::string map_what =
+      "--particles " + std::to_string(job.particles) +
+      (job.subdivide > 0 ? " --subdivide " + std::to_string(job.subdivide) : std::string());
+  check_memory(map_bytes, map_what, job.max_memory_mb);
   auto session = std::make_unique<MapSession>();
   MapSession& s = *session;
   // An image source is a plane carrying the image; its region is the rectangle or the inscribed
@@ -180,6 +200,11 @@ std::unique_ptr<MapSession> run_map_job(const MapJob& job, const ProgressCallbac
   s.target = surface("mesh|" + job.target + "|" + job.scheme,
                      [&] { return load_surface(job.target, job.scheme); });
   print_warnings(s.target.warnings, job.quiet);
+  if (job.extra_bytes > 0.0 || job.extra_bytes_per_target_face > 0.0) {
+    const double faces = static_cast<double>(s.target.mesh->num_faces());
+    check_memory(map_bytes + job.extra_bytes + job.extra_bytes_per_target_face * faces,
+                 map_what + " " + job.extra_what, job.max_memory_mb);
+  }
 
   RegionSpec source_spec =
       s.image ? s.image->region : parse_region_flag(job.source_region, "--source-region");

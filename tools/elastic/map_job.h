@@ -44,10 +44,20 @@ struct MapJob {
   std::string scheme = "auto";               ///< --scheme auto|loop|catmull-clark
   int subdivide = 0;                         ///< --subdivide K: refinement levels after the map
   int threads = 0;                           ///< --threads N (0: all)
-  unsigned long seed = 0;                    ///< --seed S
+  double jitter = 0.0;                       ///< --jitter F: random start of the sampling
+  unsigned long seed = 0;                    ///< --seed S: seed of the --jitter
   long max_iterations = 0;                   ///< --max-iterations (0: the solver's default)
   std::string report;                        ///< --report FILE
   bool quiet = false;                        ///< --quiet
+
+  /// --max-memory MB: the most memory the run may be estimated to need (0: the default,
+  /// default_max_memory_mb()).
+  long long max_memory_mb = 0;
+  /// Memory a command needs beyond the map (a paste's painted mesh): fixed bytes, and bytes per
+  /// face of the target's control mesh; checked with the map's estimate once the target is read.
+  double extra_bytes = 0.0;
+  double extra_bytes_per_target_face = 0.0;
+  std::string extra_what;  ///< what the extra is, for the message (e.g. "--resolution 8")
 
   /// --max-image-pixels: the most pixels any image the job reads may have (checked from headers)
   long long max_image_pixels = kDefaultMaxImagePixels;

@@ -68,6 +68,48 @@ std::string stb_reason() {
   return reason != nullptr && *reason != '\0' ? reason : "unknown reason";
 }
 
+/// Checks every Huffman table of a JPEG before stb sees it: a table of more than 256 codes makes
+/// stb_image (the Debian 2022 version) write past its 257-entry size table (found by
+/// tests/fuzz/image_fuzzer.cpp, three times with three ways around a marker walk). So the check
+/// does not follow stb's parsing: in a file that starts like a JPEG (0xFF, fill bytes, SOI), every
+/// DHT marker bytes 0xFF 0xC4 anywhere is read as stb would read a DHT segment there (tables of a
+/// class byte and 16 counts, missing bytes as zeros, while the segment's length lasts). A valid
+/// JPEG has these bytes only at its DHT segments (entropy-coded data stuffs every 0xFF), so it
+/// passes; a file with them inside other data (e.g. an ICC profile) is checked there too, and
+/// refused only if the bytes after them would be a table that overflows stb. \throws
+/// InvalidInputError naming the file.
+void check_jpeg_huffman_tables(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  const auto next = [&in]() { return in.get(); };  // EOF: -1
+  int c = next();
+  if (c != 0xFF) return;
+  while (c == 0xFF) c = next();
+  if (c != 0xD8) return;
+  int previous = c;
+  for (c = next(); c >= 0; previous = c, c = next()) {
+    if (previous != 0xFF || c != 0xC4) continue;
+    const std::streampos resume = in.tellg();
+    const int high = next(), low = next();
+    long remaining = std::max(high, 0) * 256L + std::max(low, 0) - 2;
+    while (remaining > 0) {
+      next();  // table class and id
+      long codes = 0;
+      for (int i = 0; i < 16; ++i) codes += std::max(next(), 0);
+      if (codes > 256) {
+        throw InvalidInputError(path.string(),
+                                "not a readable image (corrupt JPEG: a Huffman table of " +
+                                    std::to_string(codes) + " codes, at most 256)");
+      }
+      in.ignore(codes);
+      remaining -= 17 + codes;
+      if (!in) break;
+    }
+    in.clear();
+    in.seekg(resume);
+    c = 0;  // not 0xFF: the scan goes on after this C4
+  }
+}
+
 }  // namespace
 
 ImageInfo read_image_info(const std::filesystem::path& path, const ImageReadOptions& options) {
@@ -79,6 +121,7 @@ ImageInfo read_image_info(const std::filesystem::path& path, const ImageReadOpti
   if (!std::ifstream(path, std::ios::binary)) {
     throw IoError(name, "cannot open the image");
   }
+  check_jpeg_huffman_tables(path);
   ImageInfo info;
   if (!stbi_info(name.c_str(), &info.width, &info.height, &info.channels) || info.width <= 0 ||
       info.height <= 0) {
