@@ -423,7 +423,8 @@ int run_paste(const PasteArgs& a, const CLI::App& sub) {
       if (!displaced.empty() && shown.positions.size() == displaced.size()) {
         shown.positions = displaced;
       }
-      if (shown.num_faces() > 0) files.push_back(preview.write_feature(stage / "preview.png", shown));
+      if (shown.num_faces() > 0)
+        files.push_back(preview.write_feature(stage / "preview.png", shown));
       if (!displaced.empty()) {
         PolygonMesh relief;
         relief.positions = displaced;

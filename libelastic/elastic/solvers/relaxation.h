@@ -27,10 +27,10 @@
 #include <vector>
 
 #include "elastic/core/progress.h"
+#include "elastic/numerics/multigrid.h"
 #include "elastic/particles/particle_grid.h"
 #include "elastic/particles/spring_energy.h"
 #include "elastic/projection/closest_point.h"
-#include "elastic/numerics/multigrid.h"
 #include "elastic/surface/surface_point.h"
 
 namespace elastic {
