@@ -13,75 +13,16 @@
 #include <string>
 #include <system_error>
 
+#include "elastic/core/detail/signal_path_registry.h"
 #include "elastic/core/error.h"
 
 namespace elastic {
 
 namespace {
 
-/// The live temporaries, in storage a signal handler may read: fixed slots of plain characters,
-/// each guarded by a lock-free atomic state. A write that finds every slot taken still works; its
-/// temporary is just not removed on a signal (the next run's stale sweep removes it).
-///   kFree -> kFilling (a writer claims the slot and copies its path) -> kLive
-///   kLive -> kRemoving (remove_temporary_files_now unlinks it) -> kLive
-///   kLive -> kFree (the writer is done with the temporary)
-class TemporaryRegistry {
- public:
-  /// A slot for `path`, or -1 when none is free or the path is too long.
-  int add(const std::string& path) noexcept {
-    if (path.size() + 1 > kPathBytes) {
-      return -1;
-    }
-    for (int i = 0; i < kSlots; ++i) {
-      Slot& slot = slots_[static_cast<size_t>(i)];
-      int expected = kFree;
-      if (slot.state.compare_exchange_strong(expected, kFilling, std::memory_order_acquire)) {
-        std::memcpy(slot.path, path.c_str(), path.size() + 1);
-        slot.state.store(kLive, std::memory_order_release);
-        return i;
-      }
-    }
-    return -1;
-  }
-
-  void release(int i) noexcept {
-    if (i < 0) {
-      return;
-    }
-    Slot& slot = slots_[static_cast<size_t>(i)];
-    int expected = kLive;
-    // While a handler unlinks this path (kRemoving), wait: its bytes must not change under it.
-    while (!slot.state.compare_exchange_weak(expected, kFree, std::memory_order_acq_rel)) {
-      expected = kLive;
-      sched_yield();
-    }
-  }
-
-  void unlink_all() noexcept {
-    for (Slot& slot : slots_) {
-      int expected = kLive;
-      if (slot.state.compare_exchange_strong(expected, kRemoving, std::memory_order_acquire)) {
-        ::unlink(slot.path);  // async-signal-safe
-        slot.state.store(kLive, std::memory_order_release);
-      }
-    }
-  }
-
- private:
-  static constexpr int kSlots = 64;
-  static constexpr size_t kPathBytes = 4096;
-  enum : int { kFree, kFilling, kLive, kRemoving };
-  struct Slot {
-    std::atomic<int> state{kFree};
-    char path[kPathBytes] = {};
-  };
-  static_assert(std::atomic<int>::is_always_lock_free,
-                "the signal handler needs lock-free atomics");
-  std::array<Slot, kSlots> slots_;
-};
-
+/// The live temporaries (core/detail/signal_path_registry.h).
 // Constant-initialised (no constructor runs at start-up), so a handler can use it at any time.
-constinit TemporaryRegistry registry;
+constinit core_detail::SignalPathRegistry<64> registry;
 
 /// Registers a temporary for the duration of a write.
 class RegisteredTemporary {
@@ -192,7 +133,7 @@ int remove_stale_temporaries(const std::filesystem::path& folder) noexcept {
 }
 
 void remove_temporary_files_now() noexcept {
-  registry.unlink_all();
+  registry.for_each_live([](const char* path) { ::unlink(path); });  // async-signal-safe
 }
 
 void write_file_atomically(const std::filesystem::path& path,

@@ -16,6 +16,7 @@
 #include <system_error>
 
 #include "elastic/core/atomic_file.h"
+#include "elastic/core/detail/signal_path_registry.h"
 #include "elastic/core/error.h"
 
 namespace elastic {
@@ -24,56 +25,9 @@ namespace {
 
 namespace fs = std::filesystem;
 
-/// The uncommitted staging folders of this process, in storage a signal handler may read (the
-/// scheme of atomic_file.cpp's registry: plain characters guarded by a lock-free state).
-class StagingRegistry {
- public:
-  int add(const std::string& path) noexcept {
-    if (path.size() + 1 > kPathBytes) return -1;
-    for (int i = 0; i < kSlots; ++i) {
-      Slot& slot = slots_[static_cast<size_t>(i)];
-      int expected = kFree;
-      if (slot.state.compare_exchange_strong(expected, kFilling, std::memory_order_acquire)) {
-        std::memcpy(slot.path, path.c_str(), path.size() + 1);
-        slot.state.store(kLive, std::memory_order_release);
-        return i;
-      }
-    }
-    return -1;
-  }
-
-  void release(int i) noexcept {
-    if (i < 0) return;
-    // A handler that is removing the folder ends the process; nothing to wait for.
-    slots_[static_cast<size_t>(i)].state.store(kFree, std::memory_order_release);
-  }
-
-  template <class F>
-  void for_each_live(F&& f) noexcept {
-    for (Slot& slot : slots_) {
-      int expected = kLive;
-      if (slot.state.compare_exchange_strong(expected, kRemoving, std::memory_order_acquire)) {
-        f(slot.path);
-        slot.state.store(kLive, std::memory_order_release);
-      }
-    }
-  }
-
- private:
-  static constexpr int kSlots = 8;
-  static constexpr size_t kPathBytes = 4096;
-  enum : int { kFree, kFilling, kLive, kRemoving };
-  struct Slot {
-    std::atomic<int> state{kFree};
-    char path[kPathBytes] = {};
-  };
-  std::array<Slot, kSlots> slots_;
-};
-
-StagingRegistry& registry() {
-  static StagingRegistry r;
-  return r;
-}
+/// The uncommitted staging folders of this process (core/detail/signal_path_registry.h);
+/// constant-initialised, so a handler can use it at any time.
+constinit core_detail::SignalPathRegistry<8> staging_registry;
 
 /// The record getdents64 fills (linux/dirent.h's linux_dirent64).
 struct DirectoryEntry64 {
@@ -220,7 +174,7 @@ StagedFolder::StagedFolder(fs::path destination, std::string name) : name_(std::
                       "): " + (ec ? ec.message() : std::string("the staging folder exists")),
                   IoError::Direction::Write);
   }
-  slot_ = registry().add(staging_.string());
+  slot_ = staging_registry.add(staging_.string());
 }
 
 StagedFolder::~StagedFolder() {
@@ -228,7 +182,7 @@ StagedFolder::~StagedFolder() {
     std::error_code ec;
     fs::remove_all(staging_, ec);
   }
-  registry().release(slot_);
+  staging_registry.release(slot_);
 }
 
 fs::path StagedFolder::final_path(const fs::path& staged) const {
@@ -286,7 +240,7 @@ void StagedFolder::commit() {
 }
 
 void remove_staging_folders_now() noexcept {
-  registry().for_each_live([](const char* path) { remove_tree_at(AT_FDCWD, path, 0); });
+  staging_registry.for_each_live([](const char* path) { remove_tree_at(AT_FDCWD, path, 0); });
 }
 
 int remove_stale_staging(const fs::path& destination) noexcept {
