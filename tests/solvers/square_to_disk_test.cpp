@@ -197,6 +197,31 @@ TEST(SquareToDisk, RobustEnergyConvergesWithoutSlivers) {
   EXPECT_LT(smallest_stretch(naive.grid, plain.positions, naive.problem.rest_scale), robust);
 }
 
+// A relaxation in phases (the held phase after a slide, the barrier run after untangling) judges
+// every phase against the first phase's gradient (RelaxationProblem::reference_gradient_norm). A
+// restart from an equilibrium with that reference is already converged: nothing moves. Before,
+// the held phase after a slide was judged against its own, already tiny, start gradient and had
+// to reduce it a million times more: round-off forbids that, and the whole camel head (a disk onto
+// a mesh with one boundary loop) failed "line search found no fold-free decrease" at a gradient
+// of 3e-6 (relative 1.9 to the held start).
+TEST(SquareToDisk, RestartFromEquilibriumWithTheFirstReferenceIsConverged) {
+  const ShapeOptions shape{.faces = ShapeFaces::Quads, .resolution = 16, .scale = 1.0};
+  const NaiveProblem naive(shape, make_cap(shape), "disk:0,0,0,0.8", 500, false);
+  const RelaxationResult first = relax(naive.problem, RelaxationOptions{});
+  ASSERT_TRUE(first.converged) << to_string(first.reason);
+  ASSERT_GT(first.initial_gradient_norm, 0.0);
+  RelaxationProblem again = naive.problem;
+  again.initial_positions = first.positions;
+  again.initial_points = first.points;
+  again.reference_gradient_norm = first.initial_gradient_norm;
+  const RelaxationResult second = relax(again, RelaxationOptions{});
+  EXPECT_TRUE(second.converged) << to_string(second.reason);
+  EXPECT_EQ(second.iterations, 0);
+  EXPECT_EQ(second.initial_gradient_norm, first.initial_gradient_norm);
+  EXPECT_LE(second.relative_gradient, RelaxationOptions{}.relative_gradient_tolerance);
+  EXPECT_EQ((second.positions - first.positions).cwiseAbs().maxCoeff(), 0.0);
+}
+
 // The goblet's squeezed stem with the robust energy: the folded start is untangled with the
 // paper's energy first (the barrier cannot cross a fold), then the barrier run converges fold-free.
 TEST(Untangle, RobustEnergyUntanglesThenConvergesOnTheGoblet) {

@@ -39,7 +39,9 @@ RelaxationResult relax_explicit(const RelaxationProblem& problem,
   result.initial_energy = energies.total();
   result.evaluations = 1;
   result.initial_folded_faces = setup.springs.folded_faces(setup.positions, setup.normals);
-  const double initial_norm = solver_detail::tangential_norm(setup, gradient, setup.normals);
+  const double start_norm = solver_detail::tangential_norm(setup, gradient, setup.normals);
+  const double initial_norm =
+      problem.reference_gradient_norm > 0.0 ? problem.reference_gradient_norm : start_norm;
   if (n == 0) {
     result.reason = StopReason::NoFreeParticles;
     result.setup_seconds = solver_detail::seconds_since(start);
@@ -97,7 +99,7 @@ RelaxationResult relax_explicit(const RelaxationProblem& problem,
   Eigen::Matrix3Xd closest = setup.positions;  // x' of every particle (boundary ones: themselves)
   Eigen::Matrix3Xd check_gradient;
   const double drift_limit = eo.drift_tolerance * setup.mean_rest;
-  double relative = initial_norm > 0.0 ? 1.0 : 0.0;
+  double relative = initial_norm > 0.0 ? start_norm / initial_norm : 0.0;
 
   result.reason = StopReason::MaxIterations;
   long step = 0;

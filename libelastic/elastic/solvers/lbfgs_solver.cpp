@@ -239,7 +239,10 @@ RelaxationResult relax_lbfgs(const RelaxationProblem& problem, const RelaxationO
   // triangles of the start can make the barrier's share of the first gradient orders of magnitude
   // larger, and a tolerance relative to that would stop far from the minimum.
   const double spring_norm = with_barrier ? solver_detail::spring_gradient_norm(setup) : q_norm;
-  const double initial_norm = spring_norm > 0.0 ? spring_norm : q_norm;
+  const double initial_norm = problem.reference_gradient_norm > 0.0
+                                  ? problem.reference_gradient_norm
+                              : spring_norm > 0.0 ? spring_norm
+                                                  : q_norm;
   result.setup_seconds = solver_detail::seconds_since(start);
   const long long solve_start = solver_detail::now_ticks();
 

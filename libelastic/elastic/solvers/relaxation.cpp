@@ -173,6 +173,7 @@ RelaxationResult relax_fast_energy(const RelaxationProblem& problem,
   again.initial_positions = paper.positions;
   again.initial_points = paper.points;
   again.boundary_parameters = paper.boundary_parameters;
+  again.reference_gradient_norm = robust.initial_gradient_norm;
   RelaxationResult result = relax_lbfgs(again, options);
   result.initial_energy = robust.initial_energy;
   result.initial_folded_faces = robust.initial_folded_faces;
@@ -210,6 +211,10 @@ RelaxationResult relax_fast(const RelaxationProblem& problem, const RelaxationOp
   held.initial_positions = slid.positions;
   held.initial_points = slid.points;
   held.boundary_parameters = slid.boundary_parameters;
+  // One relaxation in two phases: the held phase's tolerances refer to the slide's start. Its own
+  // start is the slide's end, often already close to equilibrium; judged against itself it would
+  // have to reduce an already small gradient a million times more, which round-off forbids.
+  held.reference_gradient_norm = slid.initial_gradient_norm;
   const std::vector<int>& loop = problem.grid->boundary_loop;
   held.boundary_targets.resize(3, static_cast<Eigen::Index>(loop.size()));
   for (std::size_t k = 0; k < loop.size(); ++k) {

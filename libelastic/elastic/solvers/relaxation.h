@@ -199,6 +199,12 @@ struct RelaxationProblem {
   /// Start parameters s_k of the boundary particles (one per grid.boundary_loop entry) for
   /// BoundaryMode::Slide; empty: the grid's boundary_parameter.
   std::vector<double> boundary_parameters;
+  /// The |P g| that the relative tolerances (relative_gradient_tolerance,
+  /// round_off_gradient_tolerance) refer to; 0: this start's own. A later phase of one relaxation
+  /// (the held phase after a slide, the barrier run after an untangling) passes the first phase's,
+  /// so that a start which is already nearly at equilibrium is judged against the problem's scale
+  /// and not asked to reduce its own small gradient a million times again.
+  double reference_gradient_norm = 0.0;
 };
 
 struct RelaxationResult {
