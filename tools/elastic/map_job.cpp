@@ -97,6 +97,10 @@ void add_map_flags(CLI::App& sub, MapJob& a) {
                  "robust (default: the paper's springs plus an injectivity barrier) or paper "
                  "(the paper's springs alone, as in Table 1)")
       ->check(CLI::IsMember({"robust", "paper"}));
+  sub.add_option("--angular-stiffness", a.angular_stiffness,
+                 "Stiffness of the angular springs relative to the normal springs (default: the "
+                 "library's, RelaxationOptions::angular_stiffness)")
+      ->check(CLI::Range(0.0, 100.0));
   sub.add_option("--scheme", a.scheme, "Subdivision scheme for both meshes")
       ->check(CLI::IsMember({"auto", "loop", "catmull-clark"}));
   sub.add_option("--subdivide", a.subdivide,
@@ -137,6 +141,7 @@ MapOptions make_map_options(const MapJob& job, const ProgressCallback& progress)
       parse_preconditioner(job.preconditioner, "--preconditioner");
   options.relaxation.threads = job.threads;
   options.relaxation.max_iterations = job.max_iterations;
+  if (job.angular_stiffness >= 0.0) options.relaxation.angular_stiffness = job.angular_stiffness;
   options.subdivisions = job.subdivide;
   options.progress = progress;
   options.relaxation.progress = progress;
