@@ -60,7 +60,7 @@ MapResult map_regions(const SurfaceProjector& source, const Region& source_regio
         grid, *result.source_disk, *result.target_disk,
         {.candidates = options.offset_candidates,
          .energy = {.stiffness = options.relaxation.stiffness,
-                    .angular_stiffness = options.relaxation.angular_stiffness,
+                    .angular_stiffness = angular_stiffness(options.relaxation),
                     .rest_scale = result.rest_scale}});
     result.boundary_offset = offset.offset;
     result.offset_chosen = true;

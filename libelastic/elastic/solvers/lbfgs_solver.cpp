@@ -217,7 +217,7 @@ RelaxationResult relax_lbfgs(const RelaxationProblem& problem, const RelaxationO
     rest_sum += options.stiffness * spring.rest * spring.rest;
   }
   for (const AngularSpring& spring : setup.grid.angular_springs) {
-    rest_sum += options.angular_stiffness * spring.rest * spring.rest;
+    rest_sum += angular_stiffness(options) * spring.rest * spring.rest;
   }
   rest_sum *= problem.rest_scale * problem.rest_scale;
   const double extent = setup.positions.cwiseAbs().maxCoeff();

@@ -101,6 +101,15 @@ EnergyKind parse_energy_kind(std::string_view text, std::string_view input) {
                           "unknown energy '" + std::string(text) + "' (expected robust or paper)");
 }
 
+double angular_stiffness(const RelaxationOptions& options) {
+  if (options.angular_stiffness) {
+    return *options.angular_stiffness;
+  }
+  // The faithful solver integrates the paper's forces whatever the energy asked for.
+  const bool paper = options.energy == EnergyKind::Paper || options.solver == SolverKind::Faithful;
+  return options.stiffness * (paper ? kPaperAngularStiffness : kRobustAngularStiffness);
+}
+
 namespace {
 
 // Fast mode with the paper's energy, and when it stops against its no-fold constraint, the
@@ -116,6 +125,7 @@ RelaxationResult relax_fast_paper(const RelaxationProblem& problem,
   again.initial_points = fast.points;
   again.boundary_parameters = fast.boundary_parameters;
   RelaxationOptions dynamics = options;
+  dynamics.angular_stiffness = angular_stiffness(options);  // the same springs as the fast run
   dynamics.solver = SolverKind::Faithful;
   dynamics.max_iterations = options.untangle_steps;
   dynamics.frame = nullptr;  // the frames are the fast solver's iterations
@@ -161,6 +171,7 @@ RelaxationResult relax_fast_energy(const RelaxationProblem& problem,
     return robust;
   }
   RelaxationOptions paper_options = options;
+  paper_options.angular_stiffness = angular_stiffness(options);  // untangle with the same springs
   paper_options.energy = EnergyKind::Paper;
   paper_options.frame = nullptr;
   const RelaxationResult paper = relax_fast_paper(problem, paper_options);

@@ -23,6 +23,7 @@
 
 #include <Eigen/Core>
 #include <functional>
+#include <optional>
 #include <string_view>
 #include <vector>
 
@@ -144,6 +145,16 @@ std::string_view to_string(EnergyKind kind);
 /// Parses "robust" or "paper". \throws InvalidInputError naming `input` otherwise.
 EnergyKind parse_energy_kind(std::string_view text, std::string_view input = "energy");
 
+/// C_a / C of the angular springs when RelaxationOptions::angular_stiffness is not set, per energy.
+/// The paper's energy keeps C_a = C (Table 1 as published). The robust energy softens the angular
+/// springs to 0.3 C: its barrier already keeps every triangle from shearing into collapse, which
+/// is what stiff angular springs guard against, and at C_a = C they pull the map away from the
+/// length energy's minimum (eq. 13) wherever source and target differ in shape. On the robustness
+/// cases (docs/results.md) 0.3 lowered the length energy by 5-30% with the symmetric Dirichlet
+/// energy within 1% of C_a = C (measured at 0.3, 1 and 3; docs/solvers.md).
+inline constexpr double kPaperAngularStiffness = 1.0;
+inline constexpr double kRobustAngularStiffness = 0.3;
+
 struct RelaxationOptions {
   SolverKind solver = SolverKind::Fast;  ///< which solver
   /// Fixed or sliding boundary particles (BoundaryMode).
@@ -156,7 +167,9 @@ struct RelaxationOptions {
   /// Smaller stretch below which the barrier acts (SpringEnergyOptions::barrier_sigma).
   double barrier_sigma = 0.4;
   double stiffness = 1.0;          ///< C of the normal springs (eq. 13)
-  double angular_stiffness = 1.0;  ///< C_a of the angular springs
+  /// C_a of the angular springs; empty: the energy's default (kPaperAngularStiffness or
+  /// kRobustAngularStiffness times `stiffness`), see angular_stiffness(const RelaxationOptions&).
+  std::optional<double> angular_stiffness;
   /// Iteration (L-BFGS) or time-step (explicit) budget; 0: 2,000 for L-BFGS, 200,000 for explicit.
   long max_iterations = 0;
   double relative_gradient_tolerance = 1e-6;  ///< stop when |P g| <= this * initial |P g|
@@ -224,6 +237,7 @@ struct RelaxationResult {
   double length_energy = 0.0;              ///< final E_len (eq. 13)
   double angular_energy = 0.0;             ///< final E_ang
   double barrier_energy = 0.0;             ///< final E_bar (0 with EnergyKind::Paper)
+  double angular_stiffness = 0.0;          ///< C_a of the run (angular_stiffness(options))
   EnergyKind energy = EnergyKind::Robust;  ///< the energy minimised (Paper for the faithful solver)
   /// Robust energy: runs of the paper's energy (with untangling) that were needed first because
   /// the start (or a fold-constrained stop) had folded faces, which the barrier cannot cross.
@@ -269,6 +283,10 @@ struct RelaxationResult {
   double magnet_stiffness = 0.0;  ///< c
   long reprojections = 0;         ///< explicit: steps that re-projected drifting particles
 };
+
+/// C_a in effect: `options.angular_stiffness` when set, else the energy's default times C (the
+/// paper's with EnergyKind::Paper or SolverKind::Faithful, which integrates the paper's forces).
+double angular_stiffness(const RelaxationOptions& options);
 
 /// Relaxes the interior particles of `problem` on the target surface.
 /// \throws InvalidInputError when the problem is inconsistent (sizes, missing grid or target,

@@ -34,7 +34,7 @@ SpringEnergyOptions energy_options(const RelaxationProblem& problem,
                                    const RelaxationOptions& options) {
   const bool barrier = options.energy == EnergyKind::Robust && options.solver == SolverKind::Fast;
   return {.stiffness = options.stiffness,
-          .angular_stiffness = options.angular_stiffness,
+          .angular_stiffness = angular_stiffness(options),
           .rest_scale = problem.rest_scale,
           .barrier_stiffness = barrier ? options.barrier_stiffness : 0.0,
           .barrier_sigma = options.barrier_sigma};
@@ -161,7 +161,7 @@ RelaxationSetup::RelaxationSetup(const RelaxationProblem& problem, const Relaxat
                   ? 0.0
                   : problem.rest_scale * sum / static_cast<double>(grid.springs.size());
   // |P g| has units of stiffness x length per particle, summed in quadrature over #P particles.
-  const double stiffness = std::max(options.stiffness, options.angular_stiffness);
+  const double stiffness = std::max(options.stiffness, angular_stiffness(options));
   absolute_bound = options.absolute_gradient_tolerance * stiffness * mean_rest *
                    std::sqrt(static_cast<double>(num_particles));
 }
@@ -239,6 +239,7 @@ void finish_result(const RelaxationSetup& setup, const RelaxationProblem& proble
   result.length_energy = energies.length;
   result.angular_energy = energies.angular;
   result.barrier_energy = energies.barrier;
+  result.angular_stiffness = setup.springs.options().angular_stiffness;
   result.energy =
       setup.springs.options().barrier_stiffness > 0.0 ? EnergyKind::Robust : EnergyKind::Paper;
   result.initial_gradient_norm = initial_gradient_norm;

@@ -29,7 +29,7 @@ Eigen::SparseMatrix<double> interior_laplacian(const RelaxationSetup& setup,
   // coordinate. Angular spring: e = x_i - (x_a + x_b)/2 = v . (x_i, x_a, x_b), Gram matrix
   // 2 C_a v v^T with v = (1, -1/2, -1/2): diagonal (2, 1/2, 1/2) C_a, (i,a) and (i,b) -C_a,
   // (a,b) +C_a/2. `visit` hands every contribution (particle, particle, value) to `emit`.
-  const double w = 2.0 * options.stiffness, ca = options.angular_stiffness;
+  const double w = 2.0 * options.stiffness, ca = angular_stiffness(options);
   const auto visit = [&](const auto& emit) {
     for (const Spring& sp : setup.grid.springs) {
       emit(sp.i, sp.i, w);
