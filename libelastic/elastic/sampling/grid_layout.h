@@ -11,22 +11,18 @@
 /// 3D
 ///    boundary curve (length L), s_k = k / M from the anchor (SurfaceCurve::locate): exact to
 ///    round-off.
-/// 3. Points of the axis-aligned square lattice of step h (origin at the centroid) are kept when
-/// they lie
-///    inside the boundary particles' polygon and at least `clearance * h` away from it. A lattice
-///    cell is a quad of the grid when its four corners are kept; the quads are cleaned to one
-///    edge-connected, hole-free set with a simple outline (cells touching only at a corner are
-///    removed). With clearance > 1/sqrt(2) no polygon point can lie inside a kept cell (the
-///    farthest point of a square from its nearest corner is its centre, h/sqrt(2) away), so the
-///    outline lies strictly inside the polygon.
-/// 4. The band between the outline and the boundary polygon is triangulated by constrained Delaunay
-///    (annulus_triangulation.h): no degenerate or inverted triangles. Guarantee: no band triangle
-///    has all three corners on the boundary. Where one would (at a sharp turn of the boundary: a
-///    rectangle's corner, a polygon's vertex), a free particle is added at its centroid and the
-///    band is triangulated again, so every face of the grid has a corner that can move.
+/// 3. Lattice and band in the plane (planar_grid.h, for any simple polygon): points of the
+///    axis-aligned square lattice of step h (origin at the centroid) at least `clearance * h`
+///    inside the boundary particles' polygon; the cells with four such corners, cleaned to one
+///    simple, hole-free patch, are the quads, strictly inside the polygon.
+/// 4. The band between the quads' outline and the boundary polygon is triangulated by constrained
+///    Delaunay (annulus_triangulation.h): no degenerate or inverted triangles, and quads plus band
+///    tile the polygon. Guarantee: no band triangle has all three corners on the boundary. Where
+///    one would (at a sharp turn of the boundary: a rectangle's corner, a star's tip), free
+///    particles are added (planar_grid.h), so every face of the grid has a corner that can move.
 /// 5. h is found by a secant/bisection search on the *actual* count (lattice vertices of the quads
-/// plus
-///    M) so that it is within `count_tolerance` of the request.
+///    plus M) so that it is within `count_tolerance` of the request; if the band's free particles
+///    then push the count past `max_count_error`, the search is repeated for N minus them.
 /// 6. Every particle is mapped to the surface through the flattening: 2D point location in the
 /// flattened
 ///    region triangles, barycentric coordinates, Region::point_in_triangle. Interior particles sit
