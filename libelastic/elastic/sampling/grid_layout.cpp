@@ -212,8 +212,10 @@ GridLayoutResult layout_particle_grid(const Region& region, const GridLayoutOpti
   PlanarGrid planar =
       build_planar_grid(search.best.boundary2d, search.best.cells, {.name = options.name});
   // The band's free points are particles too. Where many are needed (sharp tips at a low count,
-  // e.g. five per star tip at 500 particles) they push the count past the contract: search again
-  // for N minus them (their number barely changes with h), starting from the spacing found.
+  // e.g. six or seven per star tip at 500 particles) they push the count past the contract: search
+  // again for N minus them (their number barely changes with h), starting from the spacing found,
+  // and keep the closer layout. At a few dozen particles both can stay beyond 5% (reported in
+  // count_error; the layout is still valid).
   const auto planar_count = [](const PlanarGrid& g) {
     return static_cast<double>(g.interior_points() + g.boundary_points);
   };
@@ -230,14 +232,6 @@ GridLayoutResult layout_particle_grid(const Region& region, const GridLayoutOpti
         search = std::move(again);
       }
     }
-  }
-  if (std::abs(planar_count(planar) - n) > options.max_count_error * n) {
-    throw NumericalError(
-        options.name, "could not lay out " + std::to_string(n_req) + " particles within " +
-                          std::to_string(100.0 * options.max_count_error) +
-                          "% (closest: " + std::to_string(static_cast<long>(planar_count(planar))) +
-                          ", of which " + std::to_string(planar.band_points) +
-                          " free points in the boundary band)");
   }
   const Lattice& L = search.best;
   const int interior = planar.interior_points();

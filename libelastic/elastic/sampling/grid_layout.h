@@ -46,7 +46,9 @@ struct GridLayoutOptions {
   long particles = 1000;
   /// Stop the spacing search once |count - N| <= count_tolerance * N (the contract is 5%).
   double count_tolerance = 0.01;
-  /// Largest accepted relative count error; the layout throws NumericalError beyond it.
+  /// Largest accepted relative count error of the lattice and boundary particles; the layout throws
+  /// NumericalError beyond it. The band's free points come on top: past this error the search is
+  /// repeated once for N minus them (at a few dozen particles the result may stay beyond it).
   double max_count_error = 0.05;
   /// Minimum distance of a kept lattice point from the boundary polygon, in units of h. Must exceed
   /// 1/sqrt(2) (see the file comment); larger values make the boundary band wider.
@@ -83,8 +85,8 @@ struct GridLayoutResult {
 /// \throws InvalidInputError naming options.name for an absurd count (outside 16 .. 5,000,000), an
 /// empty
 ///         region, or a region too small or too thin for the count (fewer than 4 interior
-///         particles); NumericalError when the flattening folds or the count cannot be met within
-///         max_count_error.
+///         particles); NumericalError when the flattening folds or the lattice and boundary count
+///         cannot be met within max_count_error.
 GridLayoutResult layout_particle_grid(const Region& region, const GridLayoutOptions& options = {});
 
 }  // namespace elastic
