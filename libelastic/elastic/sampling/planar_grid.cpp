@@ -228,31 +228,55 @@ BandTriangulation triangulate_band(const std::vector<Eigen::Vector2d>& flat_posi
   return band;
 }
 
-}  // namespace
+// The quads of the selected cells and their outline, counter-clockwise: cell edges with no
+// selected cell on their right. `point_id` numbers the lattice points (-1: unused).
+void add_quads_and_outline(const PlanarLattice& L, const std::vector<int>& point_id,
+                           const std::string& name, PlanarGrid& grid) {
+  const auto id = [&](int i, int j) { return point_id[static_cast<size_t>(j) * L.nx + i]; };
+  std::map<int, int> next_on_outline;
+  int first_outline = std::numeric_limits<int>::max();
+  for (int b = 0; b + 1 < L.ny; ++b) {
+    for (int a = 0; a + 1 < L.nx; ++a) {
+      if (!L.cell(a, b)) {
+        continue;
+      }
+      const int v00 = id(a, b), v10 = id(a + 1, b), v11 = id(a + 1, b + 1), v01 = id(a, b + 1);
+      grid.quads.emplace_back(v00, v10, v11, v01);
+      const auto edge = [&](bool open, int from, int to) {
+        if (!open) {
+          return;
+        }
+        next_on_outline[from] = to;
+        first_outline = std::min(first_outline, from);
+      };
+      edge(!L.cell(a, b - 1), v00, v10);
+      edge(!L.cell(a + 1, b), v10, v11);
+      edge(!L.cell(a, b + 1), v11, v01);
+      edge(!L.cell(a - 1, b), v01, v00);
+    }
+  }
+  for (int v = first_outline;;) {
+    grid.outline.push_back(v);
+    v = next_on_outline.at(v);
+    if (v == first_outline) {
+      break;
+    }
+    if (grid.outline.size() > next_on_outline.size()) {
+      throw NumericalError(name, "grid layout: the quad outline is not one simple loop");
+    }
+  }
+  if (grid.outline.size() != next_on_outline.size()) {
+    throw NumericalError(name, "grid layout: the quad outline is not one simple loop");
+  }
+}
 
-PlanarLattice select_lattice_cells(const std::vector<Eigen::Vector2d>& polygon, double h,
-                                   const Eigen::Vector2d& offset,
-                                   const PlanarLatticeOptions& options) {
-  PlanarLattice L;
-  L.h = h;
-  L.offset = offset;
+// Lattice points of L (its frame: h, offset, i0, j0, nx, ny) inside the polygon and at least
+// `clear` from each of its edges, as flags in row order.
+std::vector<char> kept_points(const std::vector<Eigen::Vector2d>& polygon, const PlanarLattice& L,
+                              double clear) {
   const int m = static_cast<int>(polygon.size());
-  if (m < 3) {
-    return L;
-  }
-  Eigen::Vector2d lo = polygon[0], hi = polygon[0];
-  for (const Eigen::Vector2d& p : polygon) {
-    lo = lo.cwiseMin(p);
-    hi = hi.cwiseMax(p);
-  }
-  L.i0 = static_cast<int>(std::ceil((lo.x() - offset.x()) / h));
-  L.j0 = static_cast<int>(std::ceil((lo.y() - offset.y()) / h));
-  L.nx = static_cast<int>(std::floor((hi.x() - offset.x()) / h)) - L.i0 + 1;
-  L.ny = static_cast<int>(std::floor((hi.y() - offset.y()) / h)) - L.j0 + 1;
-  if (L.nx < 2 || L.ny < 2) {
-    L.nx = L.ny = 0;
-    return L;
-  }
+  const double h = L.h;
+  const Eigen::Vector2d& offset = L.offset;
   std::vector<char> keep(static_cast<size_t>(L.nx) * L.ny, 0);
 
   // Inside test by scanlines: crossings of each lattice row with the polygon's edges (half-open
@@ -280,7 +304,6 @@ PlanarLattice select_lattice_cells(const std::vector<Eigen::Vector2d>& polygon, 
   }
   // Clearance: reject points closer than clearance * h to any polygon edge (each edge visits the
   // lattice points in its bounding box grown by the clearance).
-  const double clear = options.clearance * h;
   for (int k = 0; k < m; ++k) {
     const Eigen::Vector2d& p = polygon[k];
     const Eigen::Vector2d& q = polygon[(k + 1) % m];
@@ -307,6 +330,35 @@ PlanarLattice select_lattice_cells(const std::vector<Eigen::Vector2d>& polygon, 
       }
     }
   }
+  return keep;
+}
+
+}  // namespace
+
+PlanarLattice select_lattice_cells(const std::vector<Eigen::Vector2d>& polygon, double h,
+                                   const Eigen::Vector2d& offset,
+                                   const PlanarLatticeOptions& options) {
+  PlanarLattice L;
+  L.h = h;
+  L.offset = offset;
+  const int m = static_cast<int>(polygon.size());
+  if (m < 3) {
+    return L;
+  }
+  Eigen::Vector2d lo = polygon[0], hi = polygon[0];
+  for (const Eigen::Vector2d& p : polygon) {
+    lo = lo.cwiseMin(p);
+    hi = hi.cwiseMax(p);
+  }
+  L.i0 = static_cast<int>(std::ceil((lo.x() - offset.x()) / h));
+  L.j0 = static_cast<int>(std::ceil((lo.y() - offset.y()) / h));
+  L.nx = static_cast<int>(std::floor((hi.x() - offset.x()) / h)) - L.i0 + 1;
+  L.ny = static_cast<int>(std::floor((hi.y() - offset.y()) / h)) - L.j0 + 1;
+  if (L.nx < 2 || L.ny < 2) {
+    L.nx = L.ny = 0;
+    return L;
+  }
+  const std::vector<char> keep = kept_points(polygon, L, options.clearance * h);
   // Cells with four kept corners, cleaned to one simple, hole-free patch.
   L.cells.assign(static_cast<size_t>(L.nx - 1) * (L.ny - 1), 0);
   for (int b = 0; b + 1 < L.ny; ++b) {
@@ -357,45 +409,7 @@ PlanarGrid build_planar_grid(const std::vector<Eigen::Vector2d>& polygon, const 
     grid.points.push_back(polygon[k]);
     grid.regular.push_back(0);
   }
-  const auto id = [&](int i, int j) { return point_id[static_cast<size_t>(j) * L.nx + i]; };
-
-  // Outline of the selected cells, counter-clockwise: cell edges with no selected cell on their
-  // right.
-  std::map<int, int> next_on_outline;
-  int first_outline = std::numeric_limits<int>::max();
-  for (int b = 0; b + 1 < L.ny; ++b) {
-    for (int a = 0; a + 1 < L.nx; ++a) {
-      if (!L.cell(a, b)) {
-        continue;
-      }
-      const int v00 = id(a, b), v10 = id(a + 1, b), v11 = id(a + 1, b + 1), v01 = id(a, b + 1);
-      grid.quads.emplace_back(v00, v10, v11, v01);
-      const auto edge = [&](bool open, int from, int to) {
-        if (!open) {
-          return;
-        }
-        next_on_outline[from] = to;
-        first_outline = std::min(first_outline, from);
-      };
-      edge(!L.cell(a, b - 1), v00, v10);
-      edge(!L.cell(a + 1, b), v10, v11);
-      edge(!L.cell(a, b + 1), v11, v01);
-      edge(!L.cell(a - 1, b), v01, v00);
-    }
-  }
-  for (int v = first_outline;;) {
-    grid.outline.push_back(v);
-    v = next_on_outline.at(v);
-    if (v == first_outline) {
-      break;
-    }
-    if (grid.outline.size() > next_on_outline.size()) {
-      throw NumericalError(name, "grid layout: the quad outline is not one simple loop");
-    }
-  }
-  if (grid.outline.size() != next_on_outline.size()) {
-    throw NumericalError(name, "grid layout: the quad outline is not one simple loop");
-  }
+  add_quads_and_outline(L, point_id, name, grid);
   std::vector<int> boundary_ids(m);
   for (int k = 0; k < m; ++k) {
     boundary_ids[k] = lattice + k;
