@@ -163,6 +163,76 @@ SpacingSearch search_spacing(const Region& region, const ScaledFlattening& flat,
   return search;
 }
 
+// The ParticleGrid of a planar layout: interior particles through the flattening onto the
+// surface, boundary particles from the curve, quads and band triangles as faces, then the springs.
+void fill_particle_grid(const Region& region, const ScaledFlattening& flat,
+                        const std::vector<BoundarySampler::Sample>& boundary,
+                        const PlanarGrid& planar, const std::string& name, ParticleGrid& grid) {
+  const int interior = planar.interior_points();
+  const int m = planar.boundary_points;
+  const int total = interior + m;
+  const std::vector<Eigen::Vector2d>& flat_positions = planar.points;
+  grid.source_points.resize(total);
+  std::vector<Eigen::Vector3d> positions(total);
+  const bool with_uv = !region.texcoords.empty();
+  if (with_uv) {
+    grid.source_uv.resize(total);
+  }
+  const TriangleLocator2D locator(flat.uv, region.triangles);
+  tbb::parallel_for(0, interior, [&](int p) {
+    TriangleLocator2D::Hit hit = locator.locate(flat_positions[p], 1e-9);
+    if (!hit.found()) {
+      hit = locator.nearest(flat_positions[p]);  // round-off at the region's edge only
+    }
+    const Eigen::Vector3d& w = hit.barycentric;
+    grid.source_points[p] = region.point_in_triangle(hit.triangle, w[1], w[2]);
+    positions[p] = region.surface->position(grid.source_points[p]);
+    if (with_uv) {
+      const Eigen::Vector3i& t = region.triangles[hit.triangle];
+      grid.source_uv[p] = w[0] * region.texcoords[t[0]] + w[1] * region.texcoords[t[1]] +
+                          w[2] * region.texcoords[t[2]];
+    }
+  });
+  for (int k = 0; k < m; ++k) {
+    const BoundarySampler::Sample& s = boundary[k];
+    grid.source_points[interior + k] = s.point;
+    positions[interior + k] = s.position;
+    if (with_uv) {
+      const Eigen::Vector3i& t = region.triangles[s.triangle];
+      grid.source_uv[interior + k] = s.barycentric[0] * region.texcoords[t[0]] +
+                                     s.barycentric[1] * region.texcoords[t[1]] +
+                                     s.barycentric[2] * region.texcoords[t[2]];
+    }
+  }
+
+  // The OpenMesh grid.
+  std::vector<GridMesh::VertexHandle> vh(total);
+  for (int p = 0; p < total; ++p) {
+    vh[p] =
+        grid.mesh.add_vertex(GridMesh::Point(positions[p].x(), positions[p].y(), positions[p].z()));
+  }
+  for (const Eigen::Vector4i& q : planar.quads) {
+    if (!grid.mesh.add_face({vh[q[0]], vh[q[1]], vh[q[2]], vh[q[3]]}).is_valid()) {
+      throw NumericalError(name, "grid layout: a quad could not be added to the grid mesh");
+    }
+  }
+  for (const Eigen::Vector3i& t : planar.triangles) {
+    if (!grid.mesh.add_face({vh[t[0]], vh[t[1]], vh[t[2]]}).is_valid()) {
+      throw NumericalError(name,
+                           "grid layout: a band triangle could not be added to the grid mesh");
+    }
+  }
+  grid.is_boundary.assign(total, 0);
+  grid.boundary_loop.resize(m);
+  grid.boundary_parameter.resize(m);
+  for (int k = 0; k < m; ++k) {
+    grid.is_boundary[interior + k] = 1;
+    grid.boundary_loop[k] = interior + k;
+    grid.boundary_parameter[k] = boundary[k].s;
+  }
+  grid.build_springs();
+}
+
 }  // namespace
 
 GridLayoutResult layout_particle_grid(const Region& region, const GridLayoutOptions& options) {
@@ -236,72 +306,9 @@ GridLayoutResult layout_particle_grid(const Region& region, const GridLayoutOpti
   const Lattice& L = search.best;
   const int interior = planar.interior_points();
   const int m = planar.boundary_points;
-  std::vector<Eigen::Vector2d>& flat_positions = planar.points;
-
-  // Surface points: interior particles through the flattening, boundary particles from the curve.
-  GridLayoutResult result;
-  ParticleGrid& grid = result.grid;
   const int total = interior + m;
-  grid.source_points.resize(total);
-  std::vector<Eigen::Vector3d> positions(total);
-  const bool with_uv = !region.texcoords.empty();
-  if (with_uv) {
-    grid.source_uv.resize(total);
-  }
-  const TriangleLocator2D locator(flat.uv, region.triangles);
-  tbb::parallel_for(0, interior, [&](int p) {
-    TriangleLocator2D::Hit hit = locator.locate(flat_positions[p], 1e-9);
-    if (!hit.found()) {
-      hit = locator.nearest(flat_positions[p]);  // round-off at the region's edge only
-    }
-    const Eigen::Vector3d& w = hit.barycentric;
-    grid.source_points[p] = region.point_in_triangle(hit.triangle, w[1], w[2]);
-    positions[p] = region.surface->position(grid.source_points[p]);
-    if (with_uv) {
-      const Eigen::Vector3i& t = region.triangles[hit.triangle];
-      grid.source_uv[p] = w[0] * region.texcoords[t[0]] + w[1] * region.texcoords[t[1]] +
-                          w[2] * region.texcoords[t[2]];
-    }
-  });
-  for (int k = 0; k < m; ++k) {
-    const BoundarySampler::Sample& s = L.boundary[k];
-    grid.source_points[interior + k] = s.point;
-    positions[interior + k] = s.position;
-    if (with_uv) {
-      const Eigen::Vector3i& t = region.triangles[s.triangle];
-      grid.source_uv[interior + k] = s.barycentric[0] * region.texcoords[t[0]] +
-                                     s.barycentric[1] * region.texcoords[t[1]] +
-                                     s.barycentric[2] * region.texcoords[t[2]];
-    }
-  }
-
-  // The OpenMesh grid.
-  std::vector<GridMesh::VertexHandle> vh(total);
-  for (int p = 0; p < total; ++p) {
-    vh[p] =
-        grid.mesh.add_vertex(GridMesh::Point(positions[p].x(), positions[p].y(), positions[p].z()));
-  }
-  for (const Eigen::Vector4i& q : planar.quads) {
-    if (!grid.mesh.add_face({vh[q[0]], vh[q[1]], vh[q[2]], vh[q[3]]}).is_valid()) {
-      throw NumericalError(options.name, "grid layout: a quad could not be added to the grid mesh");
-    }
-  }
-  for (const Eigen::Vector3i& t : planar.triangles) {
-    if (!grid.mesh.add_face({vh[t[0]], vh[t[1]], vh[t[2]]}).is_valid()) {
-      throw NumericalError(options.name,
-                           "grid layout: a band triangle could not be added to the grid mesh");
-    }
-  }
-  grid.is_boundary.assign(total, 0);
-  grid.boundary_loop.resize(m);
-  grid.boundary_parameter.resize(m);
-  for (int k = 0; k < m; ++k) {
-    grid.is_boundary[interior + k] = 1;
-    grid.boundary_loop[k] = interior + k;
-    grid.boundary_parameter[k] = L.boundary[k].s;
-  }
-  grid.build_springs();
-
+  GridLayoutResult result;
+  fill_particle_grid(region, flat, L.boundary, planar, options.name, result.grid);
   result.spacing = L.cells.h;
   result.interior_particles = interior;
   result.band_points = planar.band_points;
@@ -311,7 +318,7 @@ GridLayoutResult layout_particle_grid(const Region& region, const GridLayoutOpti
   result.count_error = (static_cast<double>(total) - n) / n;
   result.search_steps = steps;
   result.flattening = flat.method;
-  result.flat_positions = std::move(flat_positions);
+  result.flat_positions = std::move(planar.points);
   result.is_regular = std::move(planar.regular);
   return result;
 }
