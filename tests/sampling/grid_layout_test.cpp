@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <map>
+#include <numbers>
 
 #include "elastic/core/error.h"
 #include "elastic/projection/closest_point.h"
@@ -213,6 +214,41 @@ TEST(GridLayout, NoFaceHasEveryCornerOnTheBoundary) {
     EXPECT_GE(layout.band_points, 1) << "N = " << n << ": the square's corners need free points";
     EXPECT_EQ(layout.interior_particles + layout.boundary_particles, grid.num_particles());
     expect_valid_faces(grid, plane.surface, 0.05);
+  }
+}
+
+// The same guarantee on a five-pointed star (36 degree tips, reflex notches) embedded in the
+// procedural plane by `points:`, as the robustness benchmark's star cases do: the layout used to
+// fail there ("band triangulation: the grid outline crosses the boundary"). Every tip holds
+// boundary particles out of the lattice's reach, so each needs free points.
+TEST(GridLayout, StarPolygonRegionLaysOut) {
+  const LimitSurface surface(make_plane({.faces = ShapeFaces::Quads, .resolution = 32}));
+  const SurfaceProjector projector(surface);
+  RegionSpec spec;
+  spec.kind = RegionSpec::Kind::Points;
+  for (int k = 0; k < 10; ++k) {
+    const double angle = std::numbers::pi / 2 + std::numbers::pi * k / 5;
+    const double r = (k % 2 == 0) ? 0.8 : 0.38 * 0.8;
+    spec.points.emplace_back(r * std::cos(angle), -0.05 + r * std::sin(angle), 0.0);
+  }
+  const Region region = make_region(projector, spec);
+  for (const long n : {500L, 2000L}) {
+    GridLayoutOptions options;
+    options.particles = n;
+    const GridLayoutResult layout = layout_particle_grid(region, options);
+    const ParticleGrid& grid = layout.grid;
+    EXPECT_LE(std::abs(layout.count_error), 0.05) << "N = " << n;
+    int all_boundary = 0;
+    for (const auto fh : grid.mesh.faces()) {
+      bool free_corner = false;
+      for (const auto vh : grid.mesh.fv_range(fh)) {
+        free_corner = free_corner || !grid.is_boundary[static_cast<size_t>(vh.idx())];
+      }
+      all_boundary += free_corner ? 0 : 1;
+    }
+    EXPECT_EQ(all_boundary, 0) << "N = " << n;
+    EXPECT_GE(layout.band_points, 5) << "N = " << n << ": each tip needs free points";
+    expect_valid_faces(grid, surface, 0.05);
   }
 }
 

@@ -18,9 +18,23 @@ std::string region_name(const Region& region) {
   return region.surface ? region.surface->name() + " region" : std::string("region");
 }
 
+/// True when the triangle has zero area in 3D (two corners at the same position, or three on a
+/// line). Such triangles occur where a limit tessellation welds two copies of a vertex with a
+/// zero-area filler triangle; every map sends them to zero area as well, so they carry no
+/// orientation and are left out of the fold count and of the conformal energy.
+bool degenerate_in_3d(const Region& region, const Eigen::Vector3i& t) {
+  const Eigen::Vector3d& p0 = region.positions[static_cast<size_t>(t[0])];
+  const Eigen::Vector3d a = region.positions[static_cast<size_t>(t[1])] - p0;
+  const Eigen::Vector3d b = region.positions[static_cast<size_t>(t[2])] - p0;
+  return a.cross(b).squaredNorm() == 0.0;
+}
+
 int count_folds(const Region& region, const std::vector<Eigen::Vector2d>& uv) {
   int folds = 0;
   for (const Eigen::Vector3i& t : region.triangles) {
+    if (degenerate_in_3d(region, t)) {
+      continue;
+    }
     const Eigen::Vector2d a = uv[static_cast<size_t>(t[1])] - uv[static_cast<size_t>(t[0])];
     const Eigen::Vector2d b = uv[static_cast<size_t>(t[2])] - uv[static_cast<size_t>(t[0])];
     if (a.x() * b.y() - a.y() * b.x() <= 0.0) {
@@ -161,6 +175,9 @@ RegionFlattening flatten_conformal(const Region& region) {
   // Unknowns: u of every vertex then v of every vertex; the quadratic form is x^T Q x.
   Triplets q;
   for (const Eigen::Vector3i& t : region.triangles) {
+    if (degenerate_in_3d(region, t)) {
+      continue;  // no Dirichlet term and, below, no area term
+    }
     for (int k = 0; k < 3; ++k) {
       const int i = t[k], j = t[(k + 1) % 3], l = t[(k + 2) % 3];
       const Eigen::Vector3d a =
@@ -183,14 +200,29 @@ RegionFlattening flatten_conformal(const Region& region) {
       }
     }
   }
+  // -A(u, v): -1/2 sum of (u_i v_j - u_j v_i) over directed edges i -> j, symmetrised.
+  const auto add_area_edge = [&](int i, int j, double sign) {
+    q.emplace_back(i, j + nv, -0.25 * sign);
+    q.emplace_back(j + nv, i, -0.25 * sign);
+    q.emplace_back(j, i + nv, 0.25 * sign);
+    q.emplace_back(i + nv, j, 0.25 * sign);
+  };
   for (int k = 0; k < nb; ++k) {
-    const int i = region.boundary[static_cast<size_t>(k)];
-    const int j = region.boundary[static_cast<size_t>((k + 1) % nb)];
-    // -1/2 (u_i v_j - u_j v_i), symmetrised.
-    q.emplace_back(i, j + nv, -0.25);
-    q.emplace_back(j + nv, i, -0.25);
-    q.emplace_back(j, i + nv, 0.25);
-    q.emplace_back(i + nv, j, 0.25);
+    add_area_edge(region.boundary[static_cast<size_t>(k)],
+                  region.boundary[static_cast<size_t>((k + 1) % nb)], 1.0);
+  }
+  // The boundary sum is the sum of every triangle's signed area. A triangle of zero 3D area has no
+  // Dirichlet term above (its cotangents are undefined), so its area must leave the energy too:
+  // otherwise E_C is no longer a sum of per-triangle conformal energies (each >= 0), and the
+  // minimiser gains by opening the triangle, which distorts the whole map and can fold the
+  // boundary (seen on a star region whose side runs through two welded copies of a tessellation
+  // vertex). Subtracting it keeps E_C >= 0 with the exact isometry of a planar region as minimiser.
+  for (const Eigen::Vector3i& t : region.triangles) {
+    if (degenerate_in_3d(region, t)) {
+      for (int k = 0; k < 3; ++k) {
+        add_area_edge(t[k], t[(k + 1) % 3], -1.0);
+      }
+    }
   }
   Eigen::SparseMatrix<double> full(2 * nv, 2 * nv);
   full.setFromTriplets(q.begin(), q.end());

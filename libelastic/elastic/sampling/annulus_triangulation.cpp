@@ -13,6 +13,7 @@
 #include <deque>
 #include <map>
 #include <stdexcept>
+#include <string>
 
 #include "elastic/core/error.h"
 
@@ -62,21 +63,22 @@ AnnulusTriangulation triangulate_annulus(const std::vector<Eigen::Vector2d>& poi
     throw InvalidInputError(options.name,
                             "band triangulation: two boundary or outline points coincide");
   }
-  try {
-    for (const std::vector<int>* loop : {&outer, &inner}) {
-      for (size_t k = 0; k < loop->size(); ++k) {
-        cdt.insert_constraint(handles[(*loop)[k]], handles[(*loop)[(k + 1) % loop->size()]]);
+  // Outer loop first, so that a crossing is attributed to the loop that has it.
+  const auto insert_loop = [&](const std::vector<int>& loop, const std::string& problem) {
+    try {
+      for (size_t k = 0; k < loop.size(); ++k) {
+        cdt.insert_constraint(handles[loop[k]], handles[loop[(k + 1) % loop.size()]]);
       }
+    } catch (const std::exception&) {
+      // Cdt::Intersection_of_constraints_exception (or a CGAL precondition failure).
+      throw InvalidInputError(options.name, "band triangulation: " + problem);
     }
-  } catch (const std::exception&) {
-    // Cdt::Intersection_of_constraints_exception (or a CGAL precondition failure).
-    throw InvalidInputError(options.name,
-                            "band triangulation: the grid outline crosses the boundary");
-  }
-  if (cdt.number_of_vertices() != expected) {
-    throw InvalidInputError(options.name,
-                            "band triangulation: the grid outline crosses the boundary");
-  }
+    if (cdt.number_of_vertices() != expected) {
+      throw InvalidInputError(options.name, "band triangulation: " + problem);
+    }
+  };
+  insert_loop(outer, options.outer_label + " crosses itself");
+  insert_loop(inner, options.inner_label + " crosses " + options.outer_label + " or itself");
 
   // Nesting levels by breadth-first flooding: crossing a constrained edge adds one level.
   for (auto f = cdt.all_faces_begin(); f != cdt.all_faces_end(); ++f) {

@@ -20,6 +20,9 @@ namespace elastic {
 struct AnnulusTriangulationOptions {
   /// Name used in error messages.
   std::string name = "annulus";
+  /// What the loops are, for error messages.
+  std::string outer_label = "the outer loop";
+  std::string inner_label = "the inner loop";
   /// Extra points (indices into the caller's point array) strictly inside the band, inserted as
   /// free vertices of the triangulation (no constraint edges). The grid layout adds them where a
   /// triangle would otherwise have all three corners on the outer loop.
@@ -35,7 +38,8 @@ struct AnnulusTriangulation {
 /// into `points` (not repeated at the end), `inner` strictly inside `outer`, with the optional
 /// free points `options.steiner` in between. \throws
 /// InvalidInputError naming options.name when a loop has fewer than 3 vertices, two used points
-///         coincide, or the polygons' edges cross each other (the band would need new points).
+///         coincide, the outer loop crosses itself, or the inner loop crosses itself or the outer
+///         loop (the band would need new points); the message says which.
 AnnulusTriangulation triangulate_annulus(const std::vector<Eigen::Vector2d>& points,
                                          const std::vector<int>& outer,
                                          const std::vector<int>& inner,

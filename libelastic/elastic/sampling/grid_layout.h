@@ -11,22 +11,18 @@
 /// 3D
 ///    boundary curve (length L), s_k = k / M from the anchor (SurfaceCurve::locate): exact to
 ///    round-off.
-/// 3. Points of the axis-aligned square lattice of step h (origin at the centroid) are kept when
-/// they lie
-///    inside the boundary particles' polygon and at least `clearance * h` away from it. A lattice
-///    cell is a quad of the grid when its four corners are kept; the quads are cleaned to one
-///    edge-connected, hole-free set with a simple outline (cells touching only at a corner are
-///    removed). With clearance > 1/sqrt(2) no polygon point can lie inside a kept cell (the
-///    farthest point of a square from its nearest corner is its centre, h/sqrt(2) away), so the
-///    outline lies strictly inside the polygon.
-/// 4. The band between the outline and the boundary polygon is triangulated by constrained Delaunay
-///    (annulus_triangulation.h): no degenerate or inverted triangles. Guarantee: no band triangle
-///    has all three corners on the boundary. Where one would (at a sharp turn of the boundary: a
-///    rectangle's corner, a polygon's vertex), a free particle is added at its centroid and the
-///    band is triangulated again, so every face of the grid has a corner that can move.
+/// 3. Lattice and band in the plane (planar_grid.h, for any simple polygon): points of the
+///    axis-aligned square lattice of step h (origin at the centroid) at least `clearance * h`
+///    inside the boundary particles' polygon; the cells with four such corners, cleaned to one
+///    simple, hole-free patch, are the quads, strictly inside the polygon.
+/// 4. The band between the quads' outline and the boundary polygon is triangulated by constrained
+///    Delaunay (annulus_triangulation.h): no degenerate or inverted triangles, and quads plus band
+///    tile the polygon. Guarantee: no band triangle has all three corners on the boundary. Where
+///    one would (at a sharp turn of the boundary: a rectangle's corner, a star's tip), free
+///    particles are added (planar_grid.h), so every face of the grid has a corner that can move.
 /// 5. h is found by a secant/bisection search on the *actual* count (lattice vertices of the quads
-/// plus
-///    M) so that it is within `count_tolerance` of the request.
+///    plus M) so that it is within `count_tolerance` of the request; if the band's free particles
+///    then push the count past `max_count_error`, the search is repeated for N minus them.
 /// 6. Every particle is mapped to the surface through the flattening: 2D point location in the
 /// flattened
 ///    region triangles, barycentric coordinates, Region::point_in_triangle. Interior particles sit
@@ -50,7 +46,9 @@ struct GridLayoutOptions {
   long particles = 1000;
   /// Stop the spacing search once |count - N| <= count_tolerance * N (the contract is 5%).
   double count_tolerance = 0.01;
-  /// Largest accepted relative count error; the layout throws NumericalError beyond it.
+  /// Largest accepted relative count error of the lattice and boundary particles; the layout throws
+  /// NumericalError beyond it. The band's free points come on top: past this error the search is
+  /// repeated once for N minus them (at a few dozen particles the result may stay beyond it).
   double max_count_error = 0.05;
   /// Minimum distance of a kept lattice point from the boundary polygon, in units of h. Must exceed
   /// 1/sqrt(2) (see the file comment); larger values make the boundary band wider.
@@ -87,8 +85,8 @@ struct GridLayoutResult {
 /// \throws InvalidInputError naming options.name for an absurd count (outside 16 .. 5,000,000), an
 /// empty
 ///         region, or a region too small or too thin for the count (fewer than 4 interior
-///         particles); NumericalError when the flattening folds or the count cannot be met within
-///         max_count_error.
+///         particles); NumericalError when the flattening folds or the lattice and boundary count
+///         cannot be met within max_count_error.
 GridLayoutResult layout_particle_grid(const Region& region, const GridLayoutOptions& options = {});
 
 }  // namespace elastic
