@@ -213,7 +213,7 @@ ELASTIC_COMMAND(
       sub.footer(
           "Example:\n  elastic info meshes/torus_quads.obj --report torus.json\n"
           "prints vertex/face counts, validation findings, the bounding box and the guessed up\n"
-          "axis (the side the model stands on: the largest flat footprint at an end of the box),\n"
+          "axis with its confidence (the end the model stands on, its open end, or +y),\n"
           "and the limit surface's principal, mean and Gaussian curvature statistics with a\n"
           "Gauss-Bonnet check on closed surfaces.");
       return [args] { return elastic::cli::run_info(*args); };
