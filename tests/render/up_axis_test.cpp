@@ -8,6 +8,7 @@
 #include <Eigen/Geometry>
 #include <cmath>
 #include <numbers>
+#include <utility>
 #include <vector>
 
 #include "elastic/core/error.h"
@@ -92,16 +93,15 @@ PolygonMesh rotated(PolygonMesh mesh, const Eigen::Matrix3d& rotation) {
   return mesh;
 }
 
-/// The 9 quarter, half and three-quarter turns about x, y and z (exact: entries 0 and +-1).
+/// Quarter turns about x, y and z, and a half turn about x (entries exactly 0 and +-1): each axis
+/// goes to each other one, and a sign flips.
 std::vector<Eigen::Matrix3d> quarter_turns() {
   std::vector<Eigen::Matrix3d> turns;
-  for (int axis = 0; axis < 3; ++axis) {
-    for (int k = 1; k < 4; ++k) {
-      const Eigen::Matrix3d r =
-          Eigen::AngleAxisd(k * std::numbers::pi / 2.0, Eigen::Vector3d::Unit(axis))
-              .toRotationMatrix();
-      turns.push_back(r.array().round().matrix());
-    }
+  for (const auto& [axis, quarters] : {std::pair{0, 1}, {1, 1}, {2, 1}, {0, 2}}) {
+    const Eigen::Matrix3d r =
+        Eigen::AngleAxisd(quarters * std::numbers::pi / 2.0, Eigen::Vector3d::Unit(axis))
+            .toRotationMatrix();
+    turns.push_back(r.array().round().matrix());
   }
   return turns;
 }
