@@ -38,10 +38,18 @@ TEST(Aiming, InfoPrintsTheBoundingBoxAndTheUpAxisItGuesses) {
   const nlohmann::json json = nlohmann::json::parse(std::ifstream(dir / "plane.json"));
   EXPECT_EQ(json["bbox_min"], nlohmann::json({-1.0, -1.0, 0.0}));
   EXPECT_EQ(json["up_axis"]["axis"], "+z");
+  EXPECT_EQ(json["up_axis"]["confidence"], "high");
   ELASTIC_REQUIRE_SHARED_MESH(spot, "spot.obj");
   const CliRun cow = elastic("info " + spot.string(), dir);
   ASSERT_EQ(cow.code, 0) << cow.err;
-  EXPECT_NE(cow.out.find("up axis (guessed): +y"), std::string::npos) << cow.out;
+  EXPECT_NE(cow.out.find("up axis (guessed): +y, confidence high"), std::string::npos) << cow.out;
+  // A bust whose crown has a larger footprint than its neck: the shape does not decide, the
+  // convention does, and info says so.
+  ELASTIC_REQUIRE_SHARED_MESH(max, "decimated-max.obj");
+  const CliRun bust = elastic("info " + max.string(), dir);
+  ASSERT_EQ(bust.code, 0) << bust.err;
+  EXPECT_NE(bust.out.find("up axis (guessed): +y, confidence low"), std::string::npos) << bust.out;
+  EXPECT_NE(bust.out.find("convention"), std::string::npos) << bust.out;
 }
 
 TEST(Aiming, LocateGivesTheClosestPointItsNormalAndAReadySpec) {

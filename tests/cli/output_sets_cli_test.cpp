@@ -265,6 +265,18 @@ TEST(CliOutputSets, MemoryEstimatesRefuseBeforeTheWorkAndNameTheFlag) {
   EXPECT_EQ(r.code, 65) << r.err;
   EXPECT_NE(r.err.find("--resolution 64"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(dir / "out"));
+  // The paste's estimate needs only the target's control mesh: it refuses before any surface is
+  // built, so a source that would not even read is never reached.
+  const fs::path broken = dir / "broken.obj";
+  std::ofstream(broken) << "v 0 0\nf 1 2 3\n";
+  r = run({"paste", "--source", broken.string(), "--source-region", "disk:0,0,0,0.5", "--target",
+           cap, "--particles", "200", "--resolution", "64", "--max-memory", "300", "--out",
+           (dir / "out").string()},
+          log);
+  EXPECT_EQ(r.code, 65) << r.err;
+  EXPECT_NE(r.err.find("--resolution 64"), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find("broken.obj"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir / "out"));
 }
 
 TEST(CliOutputSets, MapSeedReproducesBitForBitAndTwoSeedsDiffer) {

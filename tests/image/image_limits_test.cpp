@@ -111,5 +111,23 @@ TEST(ImageLimits, JpegHuffmanTablesOfMoreThan256CodesAreRefused) {
   EXPECT_EQ(good.height, 3);
 }
 
+TEST(ImageLimits, PngWithAnEmptyIdatBeforeItsDataDecodes) {
+  // A valid 3 x 2 grey PNG whose first IDAT chunk is empty (the format allows it): stb_image copies
+  // that chunk into its unallocated buffer, memcpy(NULL, ..., 0), undefined behaviour that the
+  // image fuzzer found (fuzz.image.regression runs this file under UBSan). read_image leaves
+  // empty IDATs out, so the file decodes to its pixels, grey 10 x + y at column x, row y.
+  const fs::path file = fs::path(ELASTIC_MESHES_DIR).parent_path() /
+                        "tests/fuzz/corpus/image/png_empty_idat_before_data.png";
+  const Image image = read_image(file);
+  ASSERT_EQ(image.width, 3);
+  ASSERT_EQ(image.height, 2);
+  for (int y = 0; y < 2; ++y) {
+    for (int x = 0; x < 3; ++x) {
+      const float grey = static_cast<float>(10 * x + y) / 255.0f;
+      EXPECT_EQ(image.at(x, y), Eigen::Vector4f(grey, grey, grey, 1.0f)) << x << "," << y;
+    }
+  }
+}
+
 }  // namespace
 }  // namespace elastic

@@ -16,8 +16,11 @@ namespace elastic::cli {
 Eigen::Vector3d resolve_up(const std::string& flag_value, const PolygonMesh& mesh,
                            std::string* reason, const std::string& flag) {
   if (flag_value.empty() || flag_value == "auto") {
-    const UpAxisGuess guess = guess_up_axis(mesh.positions);
-    if (reason != nullptr) *reason = "guessed: " + guess.reason;
+    const UpAxisGuess guess = guess_up_axis(mesh);
+    if (reason != nullptr) {
+      *reason =
+          std::string("guessed (confidence ") + to_string(guess.confidence) + "): " + guess.reason;
+    }
     return guess.direction;
   }
   try {

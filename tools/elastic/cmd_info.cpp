@@ -99,8 +99,9 @@ int run_info(const InfoArgs& args) {
     hi = hi.cwiseMax(p);
   }
 
-  // Which way is up (render/up_axis.h: the side the model stands on), from the control mesh.
-  const UpAxisGuess up = guess_up_axis(mesh.positions);
+  // Which way is up (render/up_axis.h: the side the model stands on, its open end, its height
+  // field, or the +y convention, and how sure that is), from the control mesh.
+  const UpAxisGuess up = guess_up_axis(mesh);
   Eigen::AlignedBox3d control_box;
   for (const Eigen::Vector3d& p : mesh.positions) control_box.extend(p);
 
@@ -120,7 +121,13 @@ int run_info(const InfoArgs& args) {
       {"findings_before_repair", before.describe()},
       {"bbox_min", {control_box.min().x(), control_box.min().y(), control_box.min().z()}},
       {"bbox_max", {control_box.max().x(), control_box.max().y(), control_box.max().z()}},
-      {"up_axis", {{"axis", up.name()}, {"reason", up.reason}, {"footprints", up.footprints}}},
+      {"up_axis",
+       {{"axis", up.name()},
+        {"confidence", to_string(up.confidence)},
+        {"reason", up.reason},
+        {"footprints", up.footprints},
+        {"open_ends", up.open_ends},
+        {"flat_ends", up.flat_ends}}},
       {"warnings", warnings},
       {"limit_surface",
        {{"scheme", scheme},
@@ -164,8 +171,8 @@ int run_info(const InfoArgs& args) {
   std::cout << "  bounding box: min (" << xyz(control_box.min()) << "), max ("
             << xyz(control_box.max()) << "), size " << xyz(size) << ", centre ("
             << xyz(control_box.center()) << ")\n"
-            << "  up axis (guessed): " << up.name() << ", " << up.reason
-            << "; previews take --up to overrule it\n";
+            << "  up axis (guessed): " << up.name() << ", confidence " << to_string(up.confidence)
+            << ": " << up.reason << "; previews take --up to overrule it\n";
   std::cout << "limit surface: " << scheme << ", " << surface.num_faces() << " ptex faces, area "
             << std::setprecision(6) << total_area << ", curvature over " << n
             << " tessellation vertices:\n";
@@ -206,7 +213,7 @@ ELASTIC_COMMAND(
       sub.footer(
           "Example:\n  elastic info meshes/torus_quads.obj --report torus.json\n"
           "prints vertex/face counts, validation findings, the bounding box and the guessed up\n"
-          "axis (the side the model stands on: the largest flat footprint at an end of the box),\n"
+          "axis with its confidence (the end the model stands on, its open end, or +y),\n"
           "and the limit surface's principal, mean and Gaussian curvature statistics with a\n"
           "Gauss-Bonnet check on closed surfaces.");
       return [args] { return elastic::cli::run_info(*args); };

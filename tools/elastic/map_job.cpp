@@ -5,11 +5,13 @@
 #include <cmath>
 #include <fstream>
 #include <iostream>
+#include <optional>
 #include <sstream>
 
 #include "command.h"
 #include "elastic/core/atomic_file.h"
 #include "elastic/core/error.h"
+#include "elastic/mesh/mesh_io.h"
 #include "elastic/regions/region_spec.h"
 #include "job_file.h"
 #include "verdict.h"
@@ -166,7 +168,26 @@ std::unique_ptr<MapSession> run_map_job(const MapJob& job, const ProgressCallbac
   const std::string map_what =
       "--particles " + std::to_string(job.particles) +
       (job.subdivide > 0 ? " --subdivide " + std::to_string(job.subdivide) : std::string());
-  check_memory(map_bytes, map_what, job.max_memory_mb);
+  check_memory(map_bytes + job.extra_bytes,
+               map_what + (job.extra_bytes > 0.0 ? " " + job.extra_what : ""), job.max_memory_mb);
+  // A command's memory per target face (a paste's painted mesh) needs the target's face count:
+  // the target's control mesh is read first and checked before any surface is built (building
+  // the limit surfaces and their search structures is the expensive part of loading).
+  const std::string target_key = "mesh|" + job.target + "|" + job.scheme;
+  std::optional<MeshReadResult> target_read;
+  if (job.extra_bytes_per_target_face > 0.0) {
+    size_t faces = 0;
+    const auto cached = cache != nullptr ? cache->find(target_key) : SurfaceCache::iterator{};
+    if (cache != nullptr && cached != cache->end()) {
+      faces = cached->second.mesh->num_faces();
+    } else {
+      target_read = read_mesh(job.target);
+      faces = target_read->mesh.num_faces();
+    }
+    check_memory(
+        map_bytes + job.extra_bytes + job.extra_bytes_per_target_face * static_cast<double>(faces),
+        map_what + " " + job.extra_what, job.max_memory_mb);
+  }
   auto session = std::make_unique<MapSession>();
   MapSession& s = *session;
   // An image source is a plane carrying the image; its region is the rectangle or the inscribed
@@ -202,14 +223,14 @@ std::unique_ptr<MapSession> run_map_job(const MapJob& job, const ProgressCallbac
           : surface("mesh|" + job.source + "|" + job.scheme,
                     [&] { return load_surface(job.source, job.scheme); });
   print_warnings(s.source.warnings, job.quiet);
-  s.target = surface("mesh|" + job.target + "|" + job.scheme,
-                     [&] { return load_surface(job.target, job.scheme); });
+  s.target = surface(target_key, [&] {
+    if (!target_read) return load_surface(job.target, job.scheme);
+    LoadedSurface loaded = surface_from_mesh(std::move(target_read->mesh), job.target, job.scheme);
+    loaded.warnings.insert(loaded.warnings.begin(), target_read->warnings.begin(),
+                           target_read->warnings.end());
+    return loaded;
+  });
   print_warnings(s.target.warnings, job.quiet);
-  if (job.extra_bytes > 0.0 || job.extra_bytes_per_target_face > 0.0) {
-    const double faces = static_cast<double>(s.target.mesh->num_faces());
-    check_memory(map_bytes + job.extra_bytes + job.extra_bytes_per_target_face * faces,
-                 map_what + " " + job.extra_what, job.max_memory_mb);
-  }
 
   RegionSpec source_spec =
       s.image ? s.image->region : parse_region_flag(job.source_region, "--source-region");

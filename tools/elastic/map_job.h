@@ -55,7 +55,8 @@ struct MapJob {
   /// default_max_memory_mb()).
   long long max_memory_mb = 0;
   /// Memory a command needs beyond the map (a paste's painted mesh): fixed bytes, and bytes per
-  /// face of the target's control mesh; checked with the map's estimate once the target is read.
+  /// face of the target's control mesh; checked with the map's estimate before any surface is
+  /// built (the per-face part as soon as the target's control mesh is read, before the source).
   double extra_bytes = 0.0;
   double extra_bytes_per_target_face = 0.0;
   std::string extra_what;  ///< what the extra is, for the message (e.g. "--resolution 8")

@@ -7,8 +7,12 @@
 #include <cmath>
 #include <cstdint>
 #include <fstream>
+#include <iterator>
+#include <limits>
 #include <memory>
+#include <optional>
 #include <string>
+#include <string_view>
 
 #include "elastic/core/atomic_file.h"
 #include "elastic/core/error.h"
@@ -110,6 +114,48 @@ void check_jpeg_huffman_tables(const std::filesystem::path& path) {
   }
 }
 
+/// The bytes of a PNG file without its zero-length IDAT chunks, or nullopt when it has none (or is
+/// not a PNG). The PNG format allows empty IDAT chunks, but stb_image (the Debian 2022 version)
+/// copies an empty IDAT that comes before any data into its still unallocated buffer,
+/// memcpy(NULL, ..., 0), undefined behaviour (found by tests/fuzz/image_fuzzer.cpp). An empty chunk
+/// carries nothing, so leaving it out decodes the same image. The walk stops at the first chunk
+/// that does not fit in the file; stb refuses such a file with its own reason.
+std::optional<std::string> png_without_empty_idat(const std::filesystem::path& path) {
+  static constexpr char kSignature[] = "\x89PNG\r\n\x1a\n";
+  constexpr size_t kSignatureSize = sizeof(kSignature) - 1;
+  std::ifstream in(path, std::ios::binary);
+  std::string bytes(kSignatureSize, '\0');
+  if (!in.read(bytes.data(), kSignatureSize) || bytes != std::string_view(kSignature)) {
+    return std::nullopt;
+  }
+  bytes.append(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  const auto big_endian = [&bytes](size_t at) {
+    std::uint32_t value = 0;
+    for (size_t i = 0; i < 4; ++i) value = (value << 8) | static_cast<unsigned char>(bytes[at + i]);
+    return value;
+  };
+  std::string kept = bytes.substr(0, kSignatureSize);
+  bool dropped = false;
+  size_t at = kSignatureSize;
+  while (bytes.size() - at >= 12) {  // length, type, data, CRC
+    const std::uint32_t length = big_endian(at);
+    if (length > bytes.size() - at - 12) break;
+    const size_t chunk_size = 12 + size_t{length};
+    if (length == 0 && bytes.compare(at + 4, 4, "IDAT") == 0) {
+      dropped = true;
+    } else {
+      kept.append(bytes, at, chunk_size);
+    }
+    at += chunk_size;
+  }
+  if (!dropped) return std::nullopt;
+  kept.append(bytes, at, std::string::npos);
+  if (kept.size() > static_cast<size_t>(std::numeric_limits<int>::max())) {
+    throw InvalidInputError(path.string(), "PNG file of more than 2 GiB with empty IDAT chunks");
+  }
+  return kept;
+}
+
 }  // namespace
 
 ImageInfo read_image_info(const std::filesystem::path& path, const ImageReadOptions& options) {
@@ -143,8 +189,13 @@ Image read_image(const std::filesystem::path& path, const ImageReadOptions& opti
   // The size comes from the header, before stb allocates anything for the pixels.
   read_image_info(path, options);
   int columns = 0, rows = 0, channels = 0;
-  const std::unique_ptr<stbi_uc, void (*)(void*)> data(
-      stbi_load(name.c_str(), &columns, &rows, &channels, 4), stbi_image_free);
+  std::unique_ptr<stbi_uc, void (*)(void*)> data(nullptr, stbi_image_free);
+  if (const std::optional<std::string> png = png_without_empty_idat(path)) {
+    data.reset(stbi_load_from_memory(reinterpret_cast<const stbi_uc*>(png->data()),
+                                     static_cast<int>(png->size()), &columns, &rows, &channels, 4));
+  } else {
+    data.reset(stbi_load(name.c_str(), &columns, &rows, &channels, 4));
+  }
   if (!data) {
     throw InvalidInputError(name, "not a readable image (" + stb_reason() + ")");
   }
