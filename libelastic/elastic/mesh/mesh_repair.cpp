@@ -10,13 +10,6 @@
 
 namespace elastic {
 
-using detail::build_edges;
-using detail::EdgeTable;
-using detail::face_components;
-using detail::finding_text;
-using detail::is_zero_area;
-using detail::solve_orientation;
-
 namespace {
 
 /// Keeps the faces with keep[f] != 0, with their corner attributes and materials, in order.
@@ -136,7 +129,7 @@ namespace {
 
 /// Keeps the component with the most faces (ties: the one with the lowest face index).
 void keep_largest_component(PolygonMesh& mesh, RepairResult& result) {
-  const std::vector<int> component = face_components(mesh, {});
+  const std::vector<int> component = detail::face_components(mesh, {});
   std::unordered_map<int, int> count;
   std::unordered_map<int, int> first_face;
   for (int f = 0; f < mesh.num_faces(); ++f) {
@@ -171,9 +164,9 @@ RepairResult repair_mesh(PolygonMesh& mesh, const RepairOptions& options) {
   const MeshValidation before = validate_mesh(mesh, options.validation);
   if (before.malformed_faces.count > 0) {
     throw InvalidInputError(options.name,
-                            finding_text(before.malformed_faces,
-                                         "malformed faces (< 3 corners or index out of "
-                                         "range); cannot repair"));
+                            detail::finding_text(before.malformed_faces,
+                                                 "malformed faces (< 3 corners or index out of "
+                                                 "range); cannot repair"));
   }
   const int nf0 = mesh.num_faces();
 
@@ -185,7 +178,7 @@ RepairResult repair_mesh(PolygonMesh& mesh, const RepairOptions& options) {
       if (has_repeated_index(mesh, f, scratch)) {
         keep[static_cast<size_t>(f)] = 0;
         ++result.removed_repeated_index_faces;
-      } else if (is_zero_area(mesh, f, options.validation.zero_area_relative_tolerance)) {
+      } else if (detail::is_zero_area(mesh, f, options.validation.zero_area_relative_tolerance)) {
         keep[static_cast<size_t>(f)] = 0;
         ++result.removed_zero_area_faces;
       }
@@ -207,7 +200,7 @@ RepairResult repair_mesh(PolygonMesh& mesh, const RepairOptions& options) {
 
   if (options.fix_winding) {
     const std::vector<char> all(static_cast<size_t>(mesh.num_faces()), 1);
-    const EdgeTable table = build_edges(mesh, all);
+    const detail::EdgeTable table = detail::build_edges(mesh, all);
     bool inconsistent = false;
     for (size_t e = 0; e < table.edges.size(); ++e) {
       const auto uses = table.uses(e);
@@ -219,7 +212,7 @@ RepairResult repair_mesh(PolygonMesh& mesh, const RepairOptions& options) {
     }
     if (inconsistent) {
       std::vector<char> flip;
-      if (solve_orientation(mesh, all, table, flip)) {
+      if (detail::solve_orientation(mesh, all, table, flip)) {
         for (int f = 0; f < mesh.num_faces(); ++f) {
           if (flip[static_cast<size_t>(f)]) {
             flip_face(mesh, f);

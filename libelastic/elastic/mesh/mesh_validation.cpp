@@ -13,14 +13,6 @@
 
 namespace elastic {
 
-using detail::build_edges;
-using detail::DisjointSets;
-using detail::EdgeTable;
-using detail::face_components;
-using detail::finding_text;
-using detail::is_zero_area;
-using detail::solve_orientation;
-
 namespace {
 void note(IndexFindings& findings, int index, int max_examples) {
   if (findings.count++ < max_examples) {
@@ -62,30 +54,33 @@ bool MeshValidation::is_clean() const {
 std::vector<std::string> MeshValidation::describe() const {
   std::vector<std::string> lines;
   if (malformed_faces.count) {
-    lines.push_back(
-        finding_text(malformed_faces, "malformed faces (< 3 corners or index out of range)"));
+    lines.push_back(detail::finding_text(malformed_faces,
+                                         "malformed faces (< 3 corners or index out of range)"));
   }
   if (non_finite_vertices.count) {
-    lines.push_back(finding_text(non_finite_vertices, "vertices with NaN/infinite coordinates"));
+    lines.push_back(
+        detail::finding_text(non_finite_vertices, "vertices with NaN/infinite coordinates"));
   }
   if (non_manifold_edges.count) {
-    lines.push_back(finding_text(non_manifold_edges, "non-manifold edges (used by > 2 faces)"));
+    lines.push_back(
+        detail::finding_text(non_manifold_edges, "non-manifold edges (used by > 2 faces)"));
   }
   if (non_manifold_vertices.count) {
-    lines.push_back(finding_text(non_manifold_vertices,
-                                 "non-manifold vertices (faces around them form no single fan)"));
+    lines.push_back(detail::finding_text(
+        non_manifold_vertices, "non-manifold vertices (faces around them form no single fan)"));
   }
   if (inconsistent_edges.count) {
-    lines.push_back(finding_text(
+    lines.push_back(detail::finding_text(
         inconsistent_edges, orientable ? "edges whose two faces disagree in orientation"
                                        : "edges whose two faces disagree in orientation (the mesh "
                                          "is not orientable)"));
   }
   if (repeated_index_faces.count) {
-    lines.push_back(finding_text(repeated_index_faces, "faces with a repeated vertex index"));
+    lines.push_back(
+        detail::finding_text(repeated_index_faces, "faces with a repeated vertex index"));
   }
   if (zero_area_faces.count) {
-    lines.push_back(finding_text(zero_area_faces, "zero-area faces"));
+    lines.push_back(detail::finding_text(zero_area_faces, "zero-area faces"));
   }
   if (num_components > 1) {
     std::ostringstream s;
@@ -97,7 +92,7 @@ std::vector<std::string> MeshValidation::describe() const {
     lines.push_back(s.str());
   }
   if (unreferenced_vertices.count) {
-    lines.push_back(finding_text(unreferenced_vertices, "unreferenced vertices"));
+    lines.push_back(detail::finding_text(unreferenced_vertices, "unreferenced vertices"));
   }
   return lines;
 }
@@ -106,8 +101,9 @@ namespace {
 
 // Non-manifold and inconsistent edges, boundary edges, and boundary loops (the connected pieces of
 // the graph of boundary edges).
-void note_edge_findings(const EdgeTable& table, int nv, int max_examples, MeshValidation& result) {
-  DisjointSets boundary(nv);
+void note_edge_findings(const detail::EdgeTable& table, int nv, int max_examples,
+                        MeshValidation& result) {
+  detail::DisjointSets boundary(nv);
   for (size_t e = 0; e < table.edges.size(); ++e) {
     const auto uses = table.uses(e);
     const auto [a, b] = table.edges[e];
@@ -140,7 +136,7 @@ void count_components(const PolygonMesh& mesh, const std::vector<char>& face_ok,
   // Components: faces joined through shared vertices, i.e. union the corners of every face.
   {
     std::unordered_map<int, int> faces_per_root;
-    for (int root : face_components(mesh, face_ok)) {
+    for (int root : detail::face_components(mesh, face_ok)) {
       if (root >= 0) {
         ++faces_per_root[root];
       }
@@ -154,7 +150,8 @@ void count_components(const PolygonMesh& mesh, const std::vector<char>& face_ok,
 }
 
 void note_non_manifold_vertices(const PolygonMesh& mesh, const std::vector<char>& face_ok,
-                                const EdgeTable& table, int max_examples, MeshValidation& result) {
+                                const detail::EdgeTable& table, int max_examples,
+                                MeshValidation& result) {
   const int nv = mesh.num_vertices();
   const int nf = mesh.num_faces();
   // Non-manifold vertices: around each vertex, join the faces that share an edge at the vertex and
@@ -193,7 +190,7 @@ void note_non_manifold_vertices(const PolygonMesh& mesh, const std::vector<char>
       const auto end = incident.begin() + start[static_cast<size_t>(v) + 1];
       return static_cast<int>(std::lower_bound(begin, end, f) - incident.begin());
     };
-    DisjointSets fans(static_cast<int>(incident.size()));
+    detail::DisjointSets fans(static_cast<int>(incident.size()));
     for (size_t e = 0; e < table.edges.size(); ++e) {
       const auto uses = table.uses(e);
       for (size_t i = 1; i < uses.size(); ++i) {
@@ -254,7 +251,7 @@ MeshValidation validate_mesh(const PolygonMesh& mesh, const ValidationOptions& o
     for (int v : face) {
       finite = finite && mesh.positions[static_cast<size_t>(v)].allFinite();
     }
-    if (finite && is_zero_area(mesh, f, options.zero_area_relative_tolerance)) {
+    if (finite && detail::is_zero_area(mesh, f, options.zero_area_relative_tolerance)) {
       note(result.zero_area_faces, f, max_examples);
     }
   }
@@ -267,7 +264,7 @@ MeshValidation validate_mesh(const PolygonMesh& mesh, const ValidationOptions& o
     }
   }
 
-  const EdgeTable table = build_edges(mesh, face_ok);
+  const detail::EdgeTable table = detail::build_edges(mesh, face_ok);
   result.num_edges = static_cast<int>(table.edges.size());
   note_edge_findings(table, nv, max_examples, result);
   count_components(mesh, face_ok, result);
@@ -275,7 +272,7 @@ MeshValidation validate_mesh(const PolygonMesh& mesh, const ValidationOptions& o
 
   if (result.non_manifold_edges.count == 0) {
     std::vector<char> flip;
-    result.orientable = solve_orientation(mesh, face_ok, table, flip);
+    result.orientable = detail::solve_orientation(mesh, face_ok, table, flip);
   }
   result.euler_characteristic =
       num_referenced - result.num_edges + (nf - result.malformed_faces.count);
@@ -316,32 +313,35 @@ std::string manifold_problem(const PolygonMesh& mesh, const MeshValidation& v,
     return "the mesh is empty (no faces)";
   }
   if (v.malformed_faces.count) {
-    return finding_text(v.malformed_faces,
-                        "malformed faces (< 3 corners or vertex index out of range)") +
+    return detail::finding_text(v.malformed_faces,
+                                "malformed faces (< 3 corners or vertex index out of range)") +
            malformed_example(mesh, v.malformed_faces);
   }
   if (v.non_finite_vertices.count) {
-    return finding_text(v.non_finite_vertices,
-                        "vertices with a non-finite (NaN or infinite) coordinate");
+    return detail::finding_text(v.non_finite_vertices,
+                                "vertices with a non-finite (NaN or infinite) coordinate");
   }
   if (v.non_manifold_edges.count) {
-    return finding_text(v.non_manifold_edges, "non-manifold edges (used by more than two faces)");
+    return detail::finding_text(v.non_manifold_edges,
+                                "non-manifold edges (used by more than two faces)");
   }
   if (v.non_manifold_vertices.count) {
-    return finding_text(v.non_manifold_vertices,
-                        "non-manifold vertices (the faces around them form no single fan)");
+    return detail::finding_text(v.non_manifold_vertices,
+                                "non-manifold vertices (the faces around them form no single fan)");
   }
   if (v.repeated_index_faces.count) {
-    return finding_text(v.repeated_index_faces, "faces with a repeated vertex index") +
+    return detail::finding_text(v.repeated_index_faces, "faces with a repeated vertex index") +
            " (repair_mesh removes them)";
   }
   if (v.inconsistent_edges.count) {
-    return finding_text(v.inconsistent_edges, "edges whose two faces disagree in orientation") +
+    return detail::finding_text(v.inconsistent_edges,
+                                "edges whose two faces disagree in orientation") +
            (v.orientable ? " (repair_mesh flips faces to fix this)"
                          : "; the mesh is not orientable");
   }
   if (!requirements.allow_zero_area_faces && v.zero_area_faces.count) {
-    return finding_text(v.zero_area_faces, "zero-area faces") + " (repair_mesh removes them)";
+    return detail::finding_text(v.zero_area_faces, "zero-area faces") +
+           " (repair_mesh removes them)";
   }
   if (!requirements.allow_several_components && v.num_components > 1) {
     return std::to_string(v.num_components) +
@@ -353,7 +353,7 @@ std::string manifold_problem(const PolygonMesh& mesh, const MeshValidation& v,
            " boundary edges) where a closed mesh is required";
   }
   if (!requirements.allow_unreferenced_vertices && v.unreferenced_vertices.count) {
-    return finding_text(v.unreferenced_vertices, "unreferenced vertices") +
+    return detail::finding_text(v.unreferenced_vertices, "unreferenced vertices") +
            " (repair_mesh removes them)";
   }
   return "";
