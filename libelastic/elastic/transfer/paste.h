@@ -14,8 +14,8 @@
 // clang-format on
 ///
 /// and write_paste() writes the results into an output folder (output_folder.h) under the names
-/// `elastic paste` uses. The command line, C++ callers and the bindings all paste through these
-/// two calls; the command adds only its flags, the distortion report and the previews.
+/// `elastic paste` uses. The command line and C++ callers (and Python, once bound) paste through
+/// these two calls; the command adds only its flags, the distortion report and the previews.
 ///
 ///     const MapResult map = map_regions(source, from, target, to, map_options);
 ///     const PasteResult pasted = paste(source, from, target, to, map, {.height = ...});
