@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "elastic/core/error.h"
+#include "elastic/particles/detail/parents_closest.h"
 
 namespace elastic {
 
@@ -78,20 +79,8 @@ RelaxationProblem initial_placement(const GridSubdivisionResult& refined,
       magnet.push_back(p);
     }
   }
-  std::vector<Eigen::Vector3d> queries(magnet.size());
-  std::vector<SurfacePoint> hints(magnet.size());
-  for (size_t k = 0; k < magnet.size(); ++k) {
-    const SubdivisionParents& parents = refined.parents[static_cast<size_t>(magnet[k])];
-    Eigen::Vector3d x = Eigen::Vector3d::Zero();
-    for (int j = 0; j < parents.count; ++j) {
-      x += coarse.positions.col(parents.parent[static_cast<size_t>(j)]);
-    }
-    queries[k] = x / parents.count;
-    hints[k] = coarse.points[static_cast<size_t>(parents.parent[0])];
-  }
-  std::vector<ClosestPoint> answers(magnet.size());
-  target.closest(std::span<const Eigen::Vector3d>(queries), std::span<ClosestPoint>(answers),
-                 std::span<const SurfacePoint>(hints));
+  const std::vector<ClosestPoint> answers = detail::closest_to_parents_mean(
+      target, refined.parents, magnet, coarse.positions, coarse.points);
   for (size_t k = 0; k < magnet.size(); ++k) {
     problem.initial_positions.col(magnet[k]) = answers[k].position;
     problem.initial_points[static_cast<size_t>(magnet[k])] = answers[k].point;

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "elastic/core/error.h"
+#include "elastic/particles/detail/parents_closest.h"
 
 namespace elastic {
 
@@ -252,20 +253,8 @@ class GridRefiner {
     if (magnet.empty()) {
       return;
     }
-    std::vector<Eigen::Vector3d> queries(magnet.size());
-    std::vector<SurfacePoint> hints(magnet.size());
-    for (size_t k = 0; k < magnet.size(); ++k) {
-      const SubdivisionParents& parents = result_.parents[static_cast<size_t>(magnet[k])];
-      Eigen::Vector3d x = Eigen::Vector3d::Zero();
-      for (int j = 0; j < parents.count; ++j) {
-        x += coarse_.col(parents.parent[static_cast<size_t>(j)]);
-      }
-      queries[k] = x / parents.count;
-      hints[k] = grid_.source_points[static_cast<size_t>(parents.parent[0])];
-    }
-    std::vector<ClosestPoint> answers(magnet.size());
-    source_.closest(std::span<const Eigen::Vector3d>(queries), std::span<ClosestPoint>(answers),
-                    std::span<const SurfacePoint>(hints));
+    const std::vector<ClosestPoint> answers = detail::closest_to_parents_mean(
+        source_, result_.parents, magnet, coarse_, grid_.source_points);
     for (size_t k = 0; k < magnet.size(); ++k) {
       out_.source_points[static_cast<size_t>(magnet[k])] = answers[k].point;
       positions_[static_cast<size_t>(magnet[k])] = answers[k].position;
@@ -359,5 +348,31 @@ GridSubdivisionResult subdivide_grid(const ParticleGrid& grid, const SurfaceProj
   check_inputs(grid, source_curve, options);
   return GridRefiner(grid, source, source_curve, options).run();
 }
+
+namespace detail {
+
+std::vector<ClosestPoint> closest_to_parents_mean(const SurfaceProjector& surface,
+                                                  const std::vector<SubdivisionParents>& parents,
+                                                  const std::vector<int>& particles,
+                                                  const Eigen::Matrix3Xd& coarse_positions,
+                                                  const std::vector<SurfacePoint>& coarse_points) {
+  std::vector<Eigen::Vector3d> queries(particles.size());
+  std::vector<SurfacePoint> hints(particles.size());
+  for (size_t k = 0; k < particles.size(); ++k) {
+    const SubdivisionParents& p = parents[static_cast<size_t>(particles[k])];
+    Eigen::Vector3d x = Eigen::Vector3d::Zero();
+    for (int j = 0; j < p.count; ++j) {
+      x += coarse_positions.col(p.parent[static_cast<size_t>(j)]);
+    }
+    queries[k] = x / p.count;
+    hints[k] = coarse_points[static_cast<size_t>(p.parent[0])];
+  }
+  std::vector<ClosestPoint> answers(particles.size());
+  surface.closest(std::span<const Eigen::Vector3d>(queries), std::span<ClosestPoint>(answers),
+                  std::span<const SurfacePoint>(hints));
+  return answers;
+}
+
+}  // namespace detail
 
 }  // namespace elastic
