@@ -19,7 +19,6 @@ namespace {
 
 using solver_detail::parametric_retraction;
 using solver_detail::tangent_frame;
-using solver_detail::TangentFrame;
 
 // A random tangent vector of length `length` at a point with unit normal n.
 Eigen::Vector3d tangent_step(const Eigen::Vector3d& n, double length, std::mt19937& rng) {
@@ -46,11 +45,11 @@ TEST(Retraction, LandsOnTheFootOfTheStepAroundExtraordinaryVertices) {
     for (int k = 0; k < 12; ++k) {
       const ClosestPoint start =
           projector.closest(c + Eigen::Vector3d(offset(rng), offset(rng), offset(rng)));
-      const TangentFrame frame = tangent_frame(surface, start.point);
+      const SurfaceDerivatives frame = tangent_frame(surface, start.point);
       const double length = 0.05 + 0.25 * (k % 4) / 3.0;
       const Eigen::Vector3d t = tangent_step(start.normal, length, rng);
       ClosestPoint out;
-      TangentFrame out_frame;
+      SurfaceDerivatives out_frame;
       ++total;
       // The plain first-order walk, for comparison: how far off it lands.
       const double a = frame.du.squaredNorm(), b = frame.du.dot(frame.dv),
@@ -83,10 +82,10 @@ TEST(Retraction, IsExactOnAPlane) {
   const LimitSurface surface(make_plane({.faces = ShapeFaces::Quads, .resolution = 4}));
   const SurfaceProjector projector(surface);
   const ClosestPoint start = projector.closest(Eigen::Vector3d(0.1, -0.2, 0.0));
-  const TangentFrame frame = tangent_frame(surface, start.point);
+  const SurfaceDerivatives frame = tangent_frame(surface, start.point);
   const Eigen::Vector3d t(0.37, 0.21, 0.0);  // crosses ptex faces of size 0.5
   ClosestPoint out;
-  TangentFrame out_frame;
+  SurfaceDerivatives out_frame;
   ASSERT_TRUE(
       parametric_retraction(surface, start.point, start.position, frame, t, out, out_frame));
   EXPECT_LT((out.position - (start.position + t)).norm(), 1e-9);

@@ -1,7 +1,9 @@
 // `elastic paste`: map the source region onto the target region (the `elastic map` flags), then
 // carry the source's colour (and optionally height and geometric detail) across and write the
 // outputs: the textured decal (OBJ + MTL + PNG), the per-vertex colour PLY, the target texture
-// with the region baked in, the displaced mesh, the pasted detail.
+// with the region baked in, the displaced mesh, the pasted detail. The paste itself is the
+// library's (transfer/paste.h: paste, write_paste); this file turns flags into its options, and
+// adds the staged output folder, the distortion report and heatmaps, the previews and the printing.
 #include <chrono>
 #include <filesystem>
 #include <fstream>
@@ -15,16 +17,13 @@
 #include "elastic/core/error.h"
 #include "elastic/core/staged_folder.h"
 #include "elastic/image/image.h"
+#include "elastic/mesh/default_material.h"
 #include "elastic/mesh/mesh_io.h"
 #include "elastic/metrics/heatmap.h"
-#include "elastic/regions/texture_coordinates.h"
-#include "elastic/transfer/bake.h"
 #include "elastic/transfer/color_source.h"
-#include "elastic/transfer/displacement.h"
-#include "elastic/transfer/geometric_detail.h"
 #include "elastic/transfer/output_folder.h"
 #include "elastic/transfer/painted_surface.h"
-#include "elastic/transfer/tangent_frames.h"
+#include "elastic/transfer/paste.h"
 #include "job_file.h"
 #include "map_job.h"
 #include "paste_preview.h"
@@ -61,13 +60,6 @@ struct PasteArgs {
   std::string baseline = "none";  // --baseline lscm|arap|dcm|none
 };
 
-std::filesystem::path first_map_kd(const PolygonMesh& mesh) {
-  for (const Material& m : mesh.materials) {
-    if (!m.diffuse_texture.empty()) return m.diffuse_texture;
-  }
-  return {};
-}
-
 bool same_file(const std::filesystem::path& a, const std::filesystem::path& b) {
   std::error_code ec;
   if (std::filesystem::exists(a, ec) && std::filesystem::exists(b, ec)) {
@@ -96,7 +88,7 @@ void check_inputs(const PasteArgs& a) {
       throw InvalidInputError(a.job.source,
                               "has no texture coordinates (needed for --color texture)");
     }
-    if (first_map_kd(source).empty()) {
+    if (first_diffuse_texture(source).empty()) {
       throw InvalidInputError(a.job.source,
                               "has no material texture (map_Kd); give one with --texture");
     }
@@ -112,8 +104,9 @@ void check_inputs(const PasteArgs& a) {
     if (!target.has_texcoords()) {
       throw InvalidInputError(a.job.target, "has no texture coordinates to bake into (--bake)");
     }
-    const std::filesystem::path image =
-        a.bake_texture.empty() ? first_map_kd(target) : std::filesystem::path(a.bake_texture);
+    const std::filesystem::path image = a.bake_texture.empty()
+                                            ? first_diffuse_texture(target)
+                                            : std::filesystem::path(a.bake_texture);
     if (image.empty()) {
       throw InvalidInputError(a.job.target,
                               "has no material texture (map_Kd) to bake into; give --bake-texture");
@@ -137,20 +130,6 @@ void check_inputs(const PasteArgs& a) {
   }
 }
 
-// The colour source the flags ask for (nullopt for --color none, or auto without colour).
-std::optional<ColorSource> make_color_source(const PasteArgs& a, const LimitSurface& source) {
-  const PolygonMesh& mesh = source.control_mesh();
-  const bool texture_possible =
-      mesh.has_texcoords() && (!a.texture.empty() || !first_map_kd(mesh).empty());
-  std::string kind = a.color;
-  if (kind == "auto") {
-    kind = texture_possible ? "texture" : mesh.has_vertex_colors() ? "vertex" : "none";
-  }
-  if (kind == "texture") return ColorSource::texture(source, a.texture, image_read_options(a.job));
-  if (kind == "vertex") return ColorSource::vertex_colors(source);
-  return std::nullopt;
-}
-
 // The colour scale of the heatmaps, as the report records it (docs/file-formats.md).
 nlohmann::json heatmap_scale_json(const HeatmapOptions& scale,
                                   const std::vector<std::string>& methods) {
@@ -171,6 +150,239 @@ nlohmann::json heatmap_scale_json(const HeatmapOptions& scale,
           {"methods", methods}};
 }
 
+// The library's paste options (transfer/paste.h) from the flags. `detail` is the --detail mesh
+// (read by the caller), or null.
+PasteOptions paste_options(const PasteArgs& a, const PolygonMesh* detail) {
+  PasteOptions o;
+  o.color = a.color == "texture"  ? PasteColor::Texture
+            : a.color == "vertex" ? PasteColor::Vertex
+            : a.color == "none"   ? PasteColor::None
+                                  : PasteColor::Auto;
+  o.texture = a.texture;
+  o.image_read = image_read_options(a.job);
+  o.resolution = a.resolution;
+  o.max_edge = a.max_edge;
+  o.texture_resolution = a.texture_resolution;
+  o.max_levels = a.max_levels;
+  o.min_vertices = a.min_vertices;
+  o.max_vertices = a.max_vertices;
+  o.bake = a.bake;
+  o.bake_texture = a.bake_texture;
+  o.alpha = static_cast<float>(a.alpha);
+  o.feather = a.feather;
+  o.height = a.height.empty()          ? PasteHeight::None
+             : a.height == "luminance" ? PasteHeight::Luminance
+                                       : PasteHeight::Image;
+  if (o.height == PasteHeight::Image) o.height_image = a.height;
+  o.height_zero = a.height_zero;
+  o.height_scale = a.height_scale;
+  o.falloff = a.falloff;
+  o.detail = detail;
+  o.detail_name = a.detail;
+  o.detail_scale = a.detail_scale;
+  return o;
+}
+
+// The map job of a paste: the painted mesh's memory is checked with the map's before the map
+// runs: the target tessellated at --resolution (resolution^2 vertices per control face), and the
+// region refined to --min-vertices (to --max-vertices when --max-edge or --texture-resolution
+// drive it).
+MapJob paste_map_job(const PasteArgs& a) {
+  MapJob job = a.job;
+  const bool refined_by_edges = a.max_edge > 0.0 || a.texture_resolution > 0;
+  job.extra_bytes = kPasteBytesPerVertex *
+                    static_cast<double>(refined_by_edges ? a.max_vertices : a.min_vertices);
+  job.extra_bytes_per_target_face =
+      kPasteBytesPerVertex * static_cast<double>(a.resolution) * a.resolution;
+  job.extra_what = "--resolution " + std::to_string(a.resolution) +
+                   (refined_by_edges ? " --max-vertices " + std::to_string(a.max_vertices)
+                                     : " --min-vertices " + std::to_string(a.min_vertices));
+  return job;
+}
+
+// Relaxation frames for the preview's animation (positions every --frames iterations).
+struct RelaxationFrames {
+  std::vector<Eigen::Matrix3Xd> positions;
+  std::vector<long> iterations;
+  FrameCallback callback() {
+    return [this](const RelaxationFrame& f) {
+      constexpr size_t kMostFrames = 64;  // a contact sheet stays readable
+      if (positions.size() < kMostFrames) {
+        positions.push_back(*f.positions);
+        iterations.push_back(f.iteration);
+      }
+    };
+  }
+};
+
+// The report's "paste" block (docs/file-formats.md).
+nlohmann::json paste_json(const PasteResult& pasted, double seconds) {
+  const TargetSamples& samples = pasted.painted.samples;
+  nlohmann::json paste;
+  paste["levels"] = samples.levels;
+  paste["limited"] = samples.limited;
+  paste["region_vertices"] = samples.num_vertices();
+  paste["region_triangles"] = samples.num_triangles();
+  paste["mesh_vertices"] = pasted.painted.num_vertices();
+  paste["mesh_triangles"] = pasted.painted.num_triangles();
+  paste["max_edge_length"] = samples.max_edge_length;
+  paste["max_source_edge_length"] = samples.max_source_edge_length;
+  paste["boundary_by_arc_length"] = samples.boundary_by_arc_length;
+  paste["nudged"] = samples.nudged;
+  paste["unresolved"] = samples.unresolved;
+  const std::optional<ColorSource>& colors = pasted.colors;
+  paste["color"] = !colors                                           ? "none"
+                   : colors->kind() == ColorSourceKind::Texture      ? "texture"
+                   : colors->kind() == ColorSourceKind::VertexColors ? "vertex"
+                                                                     : "scalar";
+  if (pasted.baked) {
+    paste["texels_painted"] = pasted.baked->texels_painted;
+    paste["texels_changed"] = pasted.baked->texels_changed;
+  }
+  if (pasted.displaced) paste["max_displacement"] = pasted.displaced->displacement.max_displacement;
+  if (pasted.detail) {
+    paste["detail_outside"] = pasted.detail->outside;
+    paste["detail_dropped_faces"] = pasted.detail->dropped_faces;
+  }
+  paste["seconds"] = seconds;
+  return paste;
+}
+
+// The methods the report, heatmaps and headline show: ElasticPaint and the --baseline, measured.
+bool shown(const MethodMeasurement& m) {
+  return m.ok && m.name != "naive";
+}
+
+// Distortion of the map (docs/metrics.md), and of a baseline on the same grid when asked, into
+// the report; the distortion heatmap of Fig. 9 (symmetric Dirichlet per grid triangle, green =
+// perfect) as PLY face and vertex colours, on one colour scale for every method measured (the
+// preview's), recorded in the report. heatmap.ply is ElasticPaint's, heatmap_<baseline>.ply the
+// baseline's. Returns the scale.
+HeatmapOptions write_distortion(const std::vector<MethodMeasurement>& methods, OutputFolder& folder,
+                                nlohmann::json& report) {
+  nlohmann::json metrics = nlohmann::json::object();
+  for (const MethodMeasurement& m : methods) metrics[m.name] = measurement_json(m);
+  report["metrics"] = metrics;
+  std::vector<const MapMetrics*> measured_metrics;
+  std::vector<std::string> measured_names;
+  for (const MethodMeasurement& m : methods) {
+    if (!shown(m)) continue;
+    measured_metrics.push_back(&m.metrics);
+    measured_names.push_back(m.name);
+  }
+  HeatmapOptions heat_scale;
+  if (measured_metrics.empty()) return heat_scale;
+  heat_scale = shared_heatmap_scale(measured_metrics);
+  for (const MethodMeasurement& m : methods) {
+    if (!shown(m)) continue;
+    const std::string name = m.name == "elastic" ? "heatmap.ply" : "heatmap_" + m.name + ".ply";
+    folder.write_mesh(name, make_heatmap(m.positions, m.metrics, heat_scale).mesh);
+  }
+  report["heatmap"] = heatmap_scale_json(heat_scale, measured_names);
+  return heat_scale;
+}
+
+// The preview pictures (--preview) and relaxation frames (--frames) into `stage`; returns the
+// written files.
+std::vector<std::filesystem::path> write_previews(const PasteArgs& a, const MapSession& session,
+                                                  const PasteResult& pasted,
+                                                  const std::vector<MethodMeasurement>& methods,
+                                                  const HeatmapOptions& heat_scale,
+                                                  const RelaxationFrames& frames,
+                                                  const std::filesystem::path& stage) {
+  const PaintedSurface& painted = pasted.painted;
+  const MapResult& result = session.result;
+  PolygonMesh surface, outside;
+  surface.positions = painted.positions;
+  outside.positions = painted.positions;
+  for (int t = 0; t < painted.num_triangles(); ++t) {
+    const Eigen::Vector3i& c = painted.triangles[static_cast<size_t>(t)];
+    surface.add_face({c[0], c[1], c[2]});
+    if (!painted.triangle_inside[static_cast<size_t>(t)]) outside.add_face({c[0], c[1], c[2]});
+  }
+  const PreviewWriter preview(session.target_region, std::move(surface), std::move(outside),
+                              {.width = a.preview_size,
+                               .height = a.preview_size,
+                               .threads = a.job.threads,
+                               .up = resolve_up(a.up, session.target.surface->control_mesh())});
+  const ParticleGrid& grid = result.sampling.grid;
+  std::vector<std::filesystem::path> files;
+  if (a.preview) {
+    const std::optional<ColorSource>& colors = pasted.colors;
+    PolygonMesh shown_mesh =
+        colors && colors->kind() == ColorSourceKind::Texture
+            ? make_decal_mesh(painted, *colors, {.texture_path = stage / "painted_decal.png"})
+        : colors ? make_colored_mesh(painted, *colors)
+                 : PolygonMesh();
+    // A height paste is shown displaced: the relief appears as shading, in preview.png under
+    // the colours and in preview_height.png alone (plain grey).
+    const std::vector<Eigen::Vector3d>* displaced =
+        pasted.displaced ? &pasted.displaced->positions : nullptr;
+    if (displaced && shown_mesh.positions.size() == displaced->size()) {
+      shown_mesh.positions = *displaced;
+    }
+    if (shown_mesh.num_faces() > 0)
+      files.push_back(preview.write_feature(stage / "preview.png", shown_mesh));
+    if (displaced) {
+      PolygonMesh relief;
+      relief.positions = *displaced;
+      for (const Eigen::Vector3i& c : painted.triangles) relief.add_face({c[0], c[1], c[2]});
+      files.push_back(preview.write_feature(stage / "preview_height.png", relief));
+    }
+    files.push_back(preview.write_grids(stage / "preview_grid.png", grid,
+                                        {&result.naive.positions, &result.relaxation.positions},
+                                        {"naive map", "ElasticPaint"}));
+    std::vector<const Eigen::Matrix3Xd*> positions;
+    std::vector<const MapMetrics*> measured;
+    std::vector<std::string> labels;
+    for (const MethodMeasurement& m : methods) {
+      if (!shown(m)) continue;
+      positions.push_back(&m.positions);
+      measured.push_back(&m.metrics);
+      labels.push_back(m.name == "elastic" ? "ElasticPaint" : m.name);
+    }
+    if (!positions.empty()) {
+      files.push_back(preview.write_heatmaps(stage / "preview_heatmap.png", positions, measured,
+                                             labels, heat_scale));
+    }
+  }
+  if (!frames.positions.empty()) {
+    for (const auto& f :
+         preview.write_frames(stage / "frames", grid, frames.positions, frames.iterations)) {
+      files.push_back(f);
+    }
+  }
+  return files;
+}
+
+// What the paste prints: the map's summary, the paste's line and files, and the headline
+// (distortion against the baseline on the same grid).
+void print_paste(const PasteArgs& a, const MapSession& session, const PasteResult& pasted,
+                 const std::vector<MethodMeasurement>& methods,
+                 const std::vector<std::filesystem::path>& files,
+                 const std::filesystem::path& report_path, double seconds) {
+  print_map_summary(a.job, session);
+  if (!a.job.quiet) {
+    const TargetSamples& samples = pasted.painted.samples;
+    std::cout << "paste: " << samples.num_triangles() << " region triangles (" << samples.levels
+              << " refinement levels) in " << pasted.painted.num_triangles() << " triangles, "
+              << seconds << " s\n";
+    for (const auto& f : files) std::cout << "  wrote " << f.string() << '\n';
+    std::cout << "  report " << report_path.string() << '\n';
+  }
+  for (const MethodMeasurement& m : methods) {
+    if (!shown(m)) continue;
+    std::cout << (m.name == "elastic" ? "ElasticPaint" : m.name) << ": length energy "
+              << m.metrics.length_energy << ", symmetric Dirichlet "
+              << m.metrics.symmetric_dirichlet << ", stretch L2 " << m.metrics.stretch_l2
+              << ", folds " << m.metrics.folds << ", " << m.seconds << " s\n";
+  }
+}
+
+double seconds_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
 int run_paste(const PasteArgs& a, const CLI::App& sub) {
   require_flag(a.out, "--out");
   require_flag(a.job.target, "--target");
@@ -189,271 +401,42 @@ int run_paste(const PasteArgs& a, const CLI::App& sub) {
     if (report_path == wanted) check_output_file(a.job.report, "--report");
   }
 
-  // The painted mesh's memory, checked with the map's before the map runs: the target
-  // tessellated at --resolution (resolution^2 vertices per control face), and the region refined
-  // to --min-vertices (to --max-vertices when --max-edge or --texture-resolution drive it).
-  MapJob job = a.job;
-  const bool refined_by_edges = a.max_edge > 0.0 || a.texture_resolution > 0;
-  job.extra_bytes = kPasteBytesPerVertex *
-                    static_cast<double>(refined_by_edges ? a.max_vertices : a.min_vertices);
-  job.extra_bytes_per_target_face =
-      kPasteBytesPerVertex * static_cast<double>(a.resolution) * a.resolution;
-  job.extra_what = "--resolution " + std::to_string(a.resolution) +
-                   (refined_by_edges ? " --max-vertices " + std::to_string(a.max_vertices)
-                                     : " --min-vertices " + std::to_string(a.min_vertices));
-
-  // Relaxation frames for the preview's animation (positions every --frames iterations).
-  std::vector<Eigen::Matrix3Xd> frames;
-  std::vector<long> frame_iterations;
-  FrameCallback frame;
-  if (a.frames > 0) {
-    frame = [&](const RelaxationFrame& f) {
-      constexpr size_t kMostFrames = 64;  // a contact sheet stays readable
-      if (frames.size() < kMostFrames) {
-        frames.push_back(*f.positions);
-        frame_iterations.push_back(f.iteration);
-      }
-    };
-  }
+  RelaxationFrames frames;
   const std::unique_ptr<MapSession> session =
-      run_map_job(job, terminal_progress(a.job.quiet), frame, a.frames);
+      run_map_job(paste_map_job(a), terminal_progress(a.job.quiet),
+                  a.frames > 0 ? frames.callback() : FrameCallback(), a.frames);
   end_progress_line();
-  const MapResult& result = session->result;
-  const LimitSurface& source = *session->source.surface;
-  const LimitSurface& target = *session->target.surface;
   nlohmann::json report = map_report(a.job, *session, job_of(sub));
-  // Every file the paste writes goes through the folder, which keeps it self-contained: textures
-  // are copied in and referenced by bare names, every OBJ face has a material.
+
+  // The paste itself (transfer/paste.h). Every file goes through the folder, which keeps it
+  // self-contained: textures are copied in and referenced by bare names, every OBJ face has a
+  // material.
+  const auto paste_start = std::chrono::steady_clock::now();
+  const std::optional<PolygonMesh> detail =
+      a.detail.empty() ? std::nullopt : std::optional<PolygonMesh>(read_mesh(a.detail).mesh);
+  const PasteResult pasted =
+      paste(*session->source.projector, session->source_region, *session->target.projector,
+            session->target_region, session->result, paste_options(a, detail ? &*detail : nullptr));
+  if (pasted.baked && same_file(dir / "baked.png", pasted.bake_input)) {
+    throw UsageError("refusing to overwrite the input texture " + pasted.bake_input.string());
+  }
   OutputFolder folder(stage);
-  std::vector<std::filesystem::path> files;
+  write_paste(folder, pasted);
+  report["paste"] = paste_json(pasted, seconds_since(paste_start));
 
-  const std::optional<ColorSource> colors = make_color_source(a, source);
-
-  // The painted target: the target tessellation cut along the region, the region refined so that
-  // a source texel (or --max-edge) is not averaged away.
-  PaintedSurfaceOptions options;
-  options.resolution = a.resolution;
-  options.name = a.job.target;
-  TargetSamplingOptions& sampling = options.sampling;
-  sampling.source_region = &session->source_region;
-  sampling.source_particles = result.sampling.grid.source_positions();
-  sampling.target_particles = result.relaxation.positions;
-  sampling.max_edge = a.max_edge;
-  sampling.max_levels = a.max_levels;
-  sampling.max_vertices = a.max_vertices;
-  sampling.min_vertices = a.min_vertices;
-  if (a.texture_resolution > 0) {
-    // About one source texel per refined edge: a texture of that size is not averaged away by
-    // the per-vertex colours.
-    sampling.max_source_edge =
-        source_texel_length(session->source_region, a.texture_resolution, a.texture_resolution);
-    if (sampling.max_source_edge == 0.0) {
-      throw InvalidInputError(source.name(), "has no texture coordinates (--texture-resolution)");
-    }
-  }
-  const auto paint_start = std::chrono::steady_clock::now();
-  const PaintedSurface painted =
-      paint_surface(target, session->target_region, result.mapping, options);
-  const TargetSamples& samples = painted.samples;
-
-  nlohmann::json paste;
-  paste["levels"] = samples.levels;
-  paste["limited"] = samples.limited;
-  paste["region_vertices"] = samples.num_vertices();
-  paste["region_triangles"] = samples.num_triangles();
-  paste["mesh_vertices"] = painted.num_vertices();
-  paste["mesh_triangles"] = painted.num_triangles();
-  paste["max_edge_length"] = samples.max_edge_length;
-  paste["max_source_edge_length"] = samples.max_source_edge_length;
-  paste["boundary_by_arc_length"] = samples.boundary_by_arc_length;
-  paste["nudged"] = samples.nudged;
-  paste["unresolved"] = samples.unresolved;
-  paste["color"] = !colors                                           ? "none"
-                   : colors->kind() == ColorSourceKind::Texture      ? "texture"
-                   : colors->kind() == ColorSourceKind::VertexColors ? "vertex"
-                                                                     : "scalar";
-
-  if (colors) {
-    if (colors->kind() == ColorSourceKind::Texture) {
-      write_decal(folder, "painted.obj", painted, *colors);
-    }
-    folder.write_mesh("colors.ply", make_colored_mesh(painted, *colors));
-    if (a.bake) {
-      const std::filesystem::path input = a.bake_texture.empty()
-                                              ? first_map_kd(target.control_mesh())
-                                              : std::filesystem::path(a.bake_texture);
-      BakeOptions bake;
-      bake.alpha = static_cast<float>(a.alpha);
-      bake.feather = a.feather;
-      bake.name = input.string();
-      const BakeResult baked = bake_texture(samples, target, *colors,
-                                            read_image(input, image_read_options(a.job)), bake);
-      if (same_file(dir / "baked.png", input))
-        throw UsageError("refusing to overwrite the input texture " + input.string());
-      const std::filesystem::path out = folder.write_image("baked.png", baked.image);
-      // The target with its own UVs and materials, the baked image in place of the input's.
-      folder.write_obj("baked.obj", make_baked_mesh(painted, out, input));
-      paste["texels_painted"] = baked.texels_painted;
-      paste["texels_changed"] = baked.texels_changed;
-    }
-  } else if (a.bake) {
-    throw InvalidInputError(a.job.source.empty() ? a.job.source_image : a.job.source,
-                            "has no colour to bake (no texture, no vertex colours)");
-  }
-
-  std::vector<Eigen::Vector3d> displaced;  // with --height: the displaced painted positions
-  if (!a.height.empty()) {
-    // One height per region vertex: from a height image indexed by the source's texture
-    // coordinates, or from the colour source's luminance.
-    std::vector<double> heights(static_cast<size_t>(samples.num_vertices()),
-                                std::numeric_limits<double>::quiet_NaN());
-    HeightImageOptions himage;
-    himage.zero_level = a.height_zero;
-    if (a.height == "luminance") {
-      if (!colors) throw InvalidInputError("--height", "luminance needs a colour source");
-      for (int i = 0; i < samples.num_vertices(); ++i) {
-        if (!samples.sources[static_cast<size_t>(i)].inside) continue;
-        const Eigen::Vector4d c =
-            colors->color(samples.sources[static_cast<size_t>(i)].point).cast<double>();
-        heights[static_cast<size_t>(i)] =
-            0.2126 * c.x() + 0.7152 * c.y() + 0.0722 * c.z() - a.height_zero;
-      }
-    } else {
-      if (!source.control_mesh().has_texcoords()) {
-        throw InvalidInputError(source.name(), "has no texture coordinates to look up --height");
-      }
-      const Image image = read_image(a.height, image_read_options(a.job));
-      std::vector<Eigen::Vector2d> uv;
-      std::vector<int> index;
-      for (int i = 0; i < samples.num_vertices(); ++i) {
-        if (!samples.sources[static_cast<size_t>(i)].inside) continue;
-        uv.push_back(texture_coordinate(source, samples.sources[static_cast<size_t>(i)].point));
-        index.push_back(i);
-      }
-      const std::vector<double> h = heights_from_image(image, uv, himage);
-      for (size_t k = 0; k < index.size(); ++k) heights[static_cast<size_t>(index[k])] = h[k];
-    }
-    DisplacementOptions displacement;
-    displacement.scale = a.height_scale;
-    displacement.falloff_width = a.falloff;
-    const DisplacementResult moved = displace_along_normals(
-        samples.positions, samples.normals, heights, samples.triangles, displacement);
-    std::vector<Eigen::Vector3d> positions = painted.positions;
-    for (int j = 0; j < samples.num_vertices(); ++j) {
-      positions[static_cast<size_t>(painted.sample_vertex_index[static_cast<size_t>(j)])] =
-          moved.positions[static_cast<size_t>(j)];
-    }
-    // The target's own UVs and materials (its texture copied in), on the displaced positions.
-    folder.write_obj("displaced.obj", make_target_mesh(painted, positions));
-    displaced = std::move(positions);
-    paste["max_displacement"] = moved.max_displacement;
-  }
-
-  if (!a.detail.empty()) {
-    const PolygonMesh detail_mesh = read_mesh(a.detail).mesh;
-    const DetailField field =
-        extract_detail(*session->source.projector, detail_mesh, {.name = a.detail});
-    const MapDifferential differential(source, target, result);
-    PasteDetailOptions detail;
-    detail.scale = a.detail_scale;
-    const PasteDetailResult pasted = paste_detail(field, result.mapping, differential, detail);
-    folder.write_obj("detail.obj", pasted.mesh);
-    paste["detail_outside"] = pasted.outside;
-    paste["detail_dropped_faces"] = pasted.dropped_faces;
-  }
-
-  paste["seconds"] =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - paint_start).count();
-  report["paste"] = paste;
-
-  // Distortion of the map (docs/metrics.md), and of a baseline on the same grid when asked.
   CompareOptions compare;
   compare.baselines.clear();
   if (a.baseline != "none")
     compare.baselines.push_back(parse_baseline_kind(a.baseline, "--baseline"));
   const std::vector<MethodMeasurement> methods = compare_methods(*session, compare);
-  nlohmann::json metrics = nlohmann::json::object();
-  for (const MethodMeasurement& m : methods) metrics[m.name] = measurement_json(m);
-  report["metrics"] = metrics;
-  // The distortion heatmap of Fig. 9 (symmetric Dirichlet per grid triangle, green = perfect) as
-  // PLY face and vertex colours, on one colour scale for every method measured (the preview's),
-  // recorded in the report. heatmap.ply is ElasticPaint's, heatmap_<baseline>.ply the baseline's.
-  std::vector<const MapMetrics*> measured_metrics;
-  std::vector<std::string> measured_names;
-  for (const MethodMeasurement& m : methods) {
-    if (!m.ok || m.name == "naive") continue;
-    measured_metrics.push_back(&m.metrics);
-    measured_names.push_back(m.name);
-  }
-  HeatmapOptions heat_scale;
-  if (!measured_metrics.empty()) {
-    heat_scale = shared_heatmap_scale(measured_metrics);
-    for (const MethodMeasurement& m : methods) {
-      if (!m.ok || m.name == "naive") continue;
-      const std::string name = m.name == "elastic" ? "heatmap.ply" : "heatmap_" + m.name + ".ply";
-      folder.write_mesh(name, make_heatmap(m.positions, m.metrics, heat_scale).mesh);
-    }
-    report["heatmap"] = heatmap_scale_json(heat_scale, measured_names);
-  }
-  files = folder.files();
-
+  const HeatmapOptions heat_scale = write_distortion(methods, folder, report);
+  std::vector<std::filesystem::path> files = folder.files();
   if (a.preview || a.frames > 0) {
-    PolygonMesh surface, outside;
-    surface.positions = painted.positions;
-    outside.positions = painted.positions;
-    for (int t = 0; t < painted.num_triangles(); ++t) {
-      const Eigen::Vector3i& c = painted.triangles[static_cast<size_t>(t)];
-      surface.add_face({c[0], c[1], c[2]});
-      if (!painted.triangle_inside[static_cast<size_t>(t)]) outside.add_face({c[0], c[1], c[2]});
-    }
-    const PreviewWriter preview(session->target_region, std::move(surface), std::move(outside),
-                                {.width = a.preview_size,
-                                 .height = a.preview_size,
-                                 .threads = a.job.threads,
-                                 .up = resolve_up(a.up, target.control_mesh())});
-    const ParticleGrid& grid = result.sampling.grid;
-    if (a.preview) {
-      PolygonMesh shown =
-          colors && colors->kind() == ColorSourceKind::Texture
-              ? make_decal_mesh(painted, *colors, {.texture_path = stage / "painted_decal.png"})
-          : colors ? make_colored_mesh(painted, *colors)
-                   : PolygonMesh();
-      // A height paste is shown displaced: the relief appears as shading, in preview.png under
-      // the colours and in preview_height.png alone (plain grey).
-      if (!displaced.empty() && shown.positions.size() == displaced.size()) {
-        shown.positions = displaced;
-      }
-      if (shown.num_faces() > 0)
-        files.push_back(preview.write_feature(stage / "preview.png", shown));
-      if (!displaced.empty()) {
-        PolygonMesh relief;
-        relief.positions = displaced;
-        for (const Eigen::Vector3i& c : painted.triangles) relief.add_face({c[0], c[1], c[2]});
-        files.push_back(preview.write_feature(stage / "preview_height.png", relief));
-      }
-      files.push_back(preview.write_grids(stage / "preview_grid.png", grid,
-                                          {&result.naive.positions, &result.relaxation.positions},
-                                          {"naive map", "ElasticPaint"}));
-      std::vector<const Eigen::Matrix3Xd*> positions;
-      std::vector<const MapMetrics*> measured;
-      std::vector<std::string> labels;
-      for (const MethodMeasurement& m : methods) {
-        if (!m.ok || m.name == "naive") continue;
-        positions.push_back(&m.positions);
-        measured.push_back(&m.metrics);
-        labels.push_back(m.name == "elastic" ? "ElasticPaint" : m.name);
-      }
-      if (!positions.empty()) {
-        files.push_back(preview.write_heatmaps(stage / "preview_heatmap.png", positions, measured,
-                                               labels, heat_scale));
-      }
-    }
-    if (!frames.empty()) {
-      for (const auto& f : preview.write_frames(stage / "frames", grid, frames, frame_iterations)) {
-        files.push_back(f);
-      }
+    for (auto& f : write_previews(a, *session, pasted, methods, heat_scale, frames, stage)) {
+      files.push_back(std::move(f));
     }
   }
+
   // The report names the files where they will be (the set is moved into place below).
   for (auto& f : files) f = dir / staged.final_path(f).lexically_relative(staged.destination());
   nlohmann::json list = nlohmann::json::array();
@@ -470,24 +453,7 @@ int run_paste(const PasteArgs& a, const CLI::App& sub) {
     write_report(report_path.string(), report);
     report_path = a.job.report;
   }
-
-  print_map_summary(a.job, *session);
-  if (!a.job.quiet) {
-    std::cout << "paste: " << samples.num_triangles() << " region triangles (" << samples.levels
-              << " refinement levels) in " << painted.num_triangles() << " triangles, "
-              << std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()
-              << " s\n";
-    for (const auto& f : files) std::cout << "  wrote " << f.string() << '\n';
-    std::cout << "  report " << report_path.string() << '\n';
-  }
-  // The headline: distortion against the baseline on the same grid.
-  for (const MethodMeasurement& m : methods) {
-    if (!m.ok || m.name == "naive") continue;
-    std::cout << (m.name == "elastic" ? "ElasticPaint" : m.name) << ": length energy "
-              << m.metrics.length_energy << ", symmetric Dirichlet "
-              << m.metrics.symmetric_dirichlet << ", stretch L2 " << m.metrics.stretch_l2
-              << ", folds " << m.metrics.folds << ", " << m.seconds << " s\n";
-  }
+  print_paste(a, *session, pasted, methods, files, report_path, seconds_since(start));
   return finish(judge_map(a.job, *session));
 }
 

@@ -40,4 +40,13 @@ int assign_default_material(PolygonMesh& mesh) {
   return missing;
 }
 
+std::filesystem::path first_diffuse_texture(const PolygonMesh& mesh) {
+  for (const Material& m : mesh.materials) {
+    if (!m.diffuse_texture.empty()) {
+      return m.diffuse_texture;
+    }
+  }
+  return {};
+}
+
 }  // namespace elastic

@@ -9,6 +9,8 @@
 /// materials under `usemtl default` and defines it in the .mtl; transfer/ outputs give it to every
 /// face explicitly.
 
+#include <filesystem>
+
 #include "elastic/mesh/polygon_mesh.h"
 
 namespace elastic {
@@ -20,5 +22,9 @@ Material default_material();
 /// empty) the default material: the mesh's material named "default" when it has one, otherwise
 /// default_material() appended. Returns the number of faces that were given it (0: unchanged).
 int assign_default_material(PolygonMesh& mesh);
+
+/// The texture (`map_Kd`) of the mesh's first material that has one; empty when none has. The
+/// image a texture colour source reads by default, and the one a bake paints into.
+std::filesystem::path first_diffuse_texture(const PolygonMesh& mesh);
 
 }  // namespace elastic

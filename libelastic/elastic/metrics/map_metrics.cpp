@@ -199,10 +199,13 @@ std::vector<Eigen::Vector3i> grid_triangles(const ParticleGrid& grid, std::vecto
   return triangles;
 }
 
-MapMetrics measure_map(const ParticleGrid& grid, const Eigen::Matrix3Xd& target_positions,
-                       const MapMetricsOptions& options) {
+namespace {
+
+// The inputs' sizes and values; returns the particles left out (the outside mask).
+std::vector<char> check_measure_inputs(const ParticleGrid& grid,
+                                       const Eigen::Matrix3Xd& target_positions,
+                                       const MapMetricsOptions& options, const std::string& name) {
   const int n = grid.num_particles();
-  const std::string name = "map metrics";
   if (target_positions.cols() != n) {
     throw InvalidInputError(name, "target positions have " +
                                       std::to_string(target_positions.cols()) + " columns for " +
@@ -228,7 +231,6 @@ MapMetrics measure_map(const ParticleGrid& grid, const Eigen::Matrix3Xd& target_
   if (grid.springs.empty()) {
     throw InvalidInputError(name, "the particle grid has no springs built");
   }
-
   const auto is_outside = [&](int p) { return !options.outside.empty() && options.outside[p]; };
   std::vector<char> skip(n, 0);
   for (int p = 0; p < n; ++p) {
@@ -241,57 +243,43 @@ MapMetrics measure_map(const ParticleGrid& grid, const Eigen::Matrix3Xd& target_
           name, "target position of particle " + std::to_string(p) + " is not finite");
     }
   }
-  const Eigen::Matrix3Xd source = grid.source_positions();
-  if (!all_finite(source)) {
-    throw InvalidInputError(name, "a source position is not finite");
-  }
+  return skip;
+}
 
-  MapMetrics out;
-  for (int p = 0; p < n; ++p) {
-    out.outside += skip[p] ? 1 : 0;
-  }
-
-  // Length energy (eq. 13, normalised by the energy of collapsing every spring to a point).
-  {
-    double num = 0.0, den = 0.0;
-    for (const Spring& s : grid.springs) {
-      if (s.i < 0 || s.i >= n || s.j < 0 || s.j >= n) {
-        throw InvalidInputError(name, "a spring index is out of range");
-      }
-      if (skip[s.i] || skip[s.j]) {
-        continue;
-      }
-      const double rest = sigma * s.rest;
-      const double len = (target_positions.col(s.j) - target_positions.col(s.i)).norm();
-      num += (len - rest) * (len - rest);
-      den += rest * rest;
-      ++out.measured_springs;
+// Length energy (eq. 13, normalised by the energy of collapsing every spring to a point).
+void measure_length_energy(const ParticleGrid& grid, const Eigen::Matrix3Xd& target_positions,
+                           const std::vector<char>& skip, double sigma, const std::string& name,
+                           MapMetrics& out) {
+  const int n = grid.num_particles();
+  double num = 0.0, den = 0.0;
+  for (const Spring& s : grid.springs) {
+    if (s.i < 0 || s.i >= n || s.j < 0 || s.j >= n) {
+      throw InvalidInputError(name, "a spring index is out of range");
     }
-    out.length_energy = den > 0.0 ? num / den : 0.0;
+    if (skip[s.i] || skip[s.j]) {
+      continue;
+    }
+    const double rest = sigma * s.rest;
+    const double len = (target_positions.col(s.j) - target_positions.col(s.i)).norm();
+    num += (len - rest) * (len - rest);
+    den += rest * rest;
+    ++out.measured_springs;
   }
+  out.length_energy = den > 0.0 ? num / den : 0.0;
+}
 
-  out.triangles = grid_triangles(grid, &out.triangle_face);
-  const int nt = static_cast<int>(out.triangles.size());
-  const int nf = static_cast<int>(grid.mesh.n_faces());
-  TriangleValues& tv = out.per_triangle;
-  FaceValues& fv = out.per_face;
+// The fold test and sigma_min, per grid face over every triangulation of the face
+// (docs/metrics.md, "Folds"): one split alone can hide an inverted corner. A quad whose corner 0
+// has moved inside the triangle (1, 2, 3) has two positive triangles along the diagonal 0-2 but
+// an inverted triangle (1, 3, 0) along the other one. Returns the number of folded faces.
+int judge_faces(const ParticleGrid& grid, const Eigen::Matrix3Xd& source,
+                const Eigen::Matrix3Xd& target_positions, const std::vector<char>& skip,
+                const MapMetricsOptions& options, const std::string& name, MapMetrics& out) {
+  const bool have_normals = options.target_normals.cols() > 0;
+  const double sigma = options.rest_scale;
   const double nan = std::numeric_limits<double>::quiet_NaN();
   const double inf = std::numeric_limits<double>::infinity();
-  for (auto* v : {&tv.s1, &tv.s2, &tv.source_area, &tv.target_area, &tv.angle_error_deg,
-                  &tv.stretch_l2, &tv.inverse_stretch_l2, &tv.area_distortion,
-                  &tv.conformal_distortion, &tv.symmetric_dirichlet}) {
-    v->assign(nt, nan);
-  }
-  tv.folded.assign(nt, 0);
-  tv.excluded.assign(nt, 0);
-  fv.folded.assign(nf, 0);
-  fv.excluded.assign(nf, 0);
-  fv.sigma_min.assign(nf, nan);
-
-  // The fold test and sigma_min, per grid face over every triangulation of the face
-  // (docs/metrics.md, "Folds"): one split alone can hide an inverted corner. A quad whose corner 0
-  // has moved inside the triangle (1, 2, 3) has two positive triangles along the diagonal 0-2 but
-  // an inverted triangle (1, 3, 0) along the other one.
+  FaceValues& fv = out.per_face;
   int folds = 0;
   double worst_sigma = inf;
   int judged_faces = 0;
@@ -343,15 +331,153 @@ MapMetrics measure_map(const ParticleGrid& grid, const Eigen::Matrix3Xd& target_
     ++judged_faces;
   }
   out.sigma_min = judged_faces > 0 ? worst_sigma : nan;
+  return folds;
+}
 
+// The sums of the per-triangle values that the map's aggregates are (weighted) means of.
+struct TriangleSums {
   double w_sum = 0.0, w_stretch = 0.0, w_area = 0.0, w_conf = 0.0, w_sd = 0.0;
   double w_inv_sum = 0.0, w_inv_stretch = 0.0;
   double w_regular = 0.0;  // source area of the non-degenerate triangles
   double max_s1 = 0.0, max_inv = 0.0;
   double angle_sum = 0.0;
   long angle_count = 0;
-  constexpr double kDeg = 180.0 / std::numbers::pi;
+};
 
+// The values of grid triangle t (not excluded) into out.per_triangle, and its share of the sums.
+void measure_triangle(int t, const Eigen::Matrix3Xd& source,
+                      const Eigen::Matrix3Xd& target_positions, const MapMetricsOptions& options,
+                      const std::string& name, MapMetrics& out, TriangleSums& sums) {
+  constexpr double kDeg = 180.0 / std::numbers::pi;
+  const double inf = std::numeric_limits<double>::infinity();
+  TriangleValues& tv = out.per_triangle;
+  const Eigen::Vector3i& tri = out.triangles[t];
+  TrianglePair pair;
+  if (!analyse_pair(source.col(tri[0]), source.col(tri[1]), source.col(tri[2]),
+                    target_positions.col(tri[0]), target_positions.col(tri[1]),
+                    target_positions.col(tri[2]), options.rest_scale, pair)) {
+    throw InvalidInputError(name,
+                            "grid triangle " + std::to_string(t) + " has zero area on the source");
+  }
+  const double sum_sq = pair.sum_sq;  // s1^2 + s2^2
+  const double prod = pair.prod;      // s1 s2
+  const double s1 = pair.s1;
+  const double s2 = pair.s2;
+  const double source_area = pair.source_area;
+  const double target_area = pair.target_area;
+
+  tv.s1[t] = s1;
+  tv.s2[t] = s2;
+  tv.source_area[t] = source_area;
+  tv.target_area[t] = target_area;
+  tv.stretch_l2[t] = std::sqrt(0.5 * sum_sq);
+
+  // A triangle shows its face's fold (either triangulation); its own values need an inverse.
+  const bool degenerate = !(prod >= options.degenerate_area_ratio);
+  tv.folded[t] = out.per_face.folded[out.triangle_face[t]];
+
+  // Corner angles (unsigned, in each triangle's own plane).
+  double worst = 0.0;
+  for (int k = 0; k < 3; ++k) {
+    const int a = tri[k], b = tri[(k + 1) % 3], c = tri[(k + 2) % 3];
+    const double src = corner_angle(source.col(a), source.col(b), source.col(c));
+    const double tgt =
+        corner_angle(target_positions.col(a), target_positions.col(b), target_positions.col(c));
+    const double diff = std::abs(tgt - src) * kDeg;
+    worst = std::max(worst, diff);
+    sums.angle_sum += diff;
+    ++sums.angle_count;
+  }
+  tv.angle_error_deg[t] = worst;
+  out.angle_error_max_deg = std::max(out.angle_error_max_deg, worst);
+
+  ++out.measured_triangles;
+  const double w = source_area;
+  sums.w_sum += w;
+  sums.w_stretch += w * 0.5 * sum_sq;
+  sums.max_s1 = std::max(sums.max_s1, s1);
+  if (degenerate) {
+    tv.inverse_stretch_l2[t] = inf;
+    tv.area_distortion[t] = inf;
+    tv.conformal_distortion[t] = inf;
+    tv.symmetric_dirichlet[t] = inf;
+    return;
+  }
+  // 1/s1^2 + 1/s2^2 = (s1^2 + s2^2) / (s1 s2)^2.
+  const double inv_sum_sq = sum_sq / (prod * prod);
+  tv.inverse_stretch_l2[t] = std::sqrt(0.5 * inv_sum_sq);
+  tv.area_distortion[t] = std::abs(std::log(prod));
+  tv.conformal_distortion[t] = s1 / s2;
+  tv.symmetric_dirichlet[t] = sum_sq + inv_sum_sq;
+  sums.w_regular += w;
+  sums.w_area += w * tv.area_distortion[t];
+  sums.w_conf += w * tv.conformal_distortion[t];
+  sums.w_sd += w * tv.symmetric_dirichlet[t];
+  // The inverse map's domain is the target triangle: weight by its area.
+  sums.w_inv_sum += target_area;
+  sums.w_inv_stretch += target_area * 0.5 * inv_sum_sq;
+  sums.max_inv = std::max(sums.max_inv, 1.0 / s2);
+}
+
+// The map's aggregates from the sums.
+void aggregate(const TriangleSums& sums, MapMetrics& out) {
+  if (sums.w_sum > 0.0) {
+    out.stretch_l2 = std::sqrt(sums.w_stretch / sums.w_sum);
+    out.stretch_linf = sums.max_s1;
+  }
+  // Degenerate triangles have no finite value in these means: they are left out (and counted in
+  // `folds` and `degenerate`).
+  if (sums.w_regular > 0.0) {
+    out.inverse_stretch_linf = sums.max_inv;
+    out.area_distortion = sums.w_area / sums.w_regular;
+    out.conformal_distortion = sums.w_conf / sums.w_regular;
+    out.symmetric_dirichlet = sums.w_sd / sums.w_regular;
+  }
+  if (sums.w_inv_sum > 0.0) {
+    out.inverse_stretch_l2 = std::sqrt(sums.w_inv_stretch / sums.w_inv_sum);
+  }
+  if (sums.angle_count > 0) {
+    out.angle_error_mean_deg = sums.angle_sum / static_cast<double>(sums.angle_count);
+  }
+}
+
+}  // namespace
+
+MapMetrics measure_map(const ParticleGrid& grid, const Eigen::Matrix3Xd& target_positions,
+                       const MapMetricsOptions& options) {
+  const int n = grid.num_particles();
+  const std::string name = "map metrics";
+  const std::vector<char> skip = check_measure_inputs(grid, target_positions, options, name);
+  const Eigen::Matrix3Xd source = grid.source_positions();
+  if (!all_finite(source)) {
+    throw InvalidInputError(name, "a source position is not finite");
+  }
+
+  MapMetrics out;
+  for (int p = 0; p < n; ++p) {
+    out.outside += skip[p] ? 1 : 0;
+  }
+  measure_length_energy(grid, target_positions, skip, options.rest_scale, name, out);
+
+  out.triangles = grid_triangles(grid, &out.triangle_face);
+  const int nt = static_cast<int>(out.triangles.size());
+  const int nf = static_cast<int>(grid.mesh.n_faces());
+  TriangleValues& tv = out.per_triangle;
+  FaceValues& fv = out.per_face;
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  for (auto* v : {&tv.s1, &tv.s2, &tv.source_area, &tv.target_area, &tv.angle_error_deg,
+                  &tv.stretch_l2, &tv.inverse_stretch_l2, &tv.area_distortion,
+                  &tv.conformal_distortion, &tv.symmetric_dirichlet}) {
+    v->assign(nt, nan);
+  }
+  tv.folded.assign(nt, 0);
+  tv.excluded.assign(nt, 0);
+  fv.folded.assign(nf, 0);
+  fv.excluded.assign(nf, 0);
+  fv.sigma_min.assign(nf, nan);
+
+  const int folds = judge_faces(grid, source, target_positions, skip, options, name, out);
+  TriangleSums sums;
   for (int t = 0; t < nt; ++t) {
     const Eigen::Vector3i& tri = out.triangles[t];
     if (skip[tri[0]] || skip[tri[1]] || skip[tri[2]]) {
@@ -359,92 +485,10 @@ MapMetrics measure_map(const ParticleGrid& grid, const Eigen::Matrix3Xd& target_
       ++out.outside_triangles;
       continue;
     }
-    TrianglePair pair;
-    if (!analyse_pair(source.col(tri[0]), source.col(tri[1]), source.col(tri[2]),
-                      target_positions.col(tri[0]), target_positions.col(tri[1]),
-                      target_positions.col(tri[2]), sigma, pair)) {
-      throw InvalidInputError(
-          name, "grid triangle " + std::to_string(t) + " has zero area on the source");
-    }
-    const double sum_sq = pair.sum_sq;  // s1^2 + s2^2
-    const double prod = pair.prod;      // s1 s2
-    const double s1 = pair.s1;
-    const double s2 = pair.s2;
-    const double source_area = pair.source_area;
-    const double target_area = pair.target_area;
-
-    tv.s1[t] = s1;
-    tv.s2[t] = s2;
-    tv.source_area[t] = source_area;
-    tv.target_area[t] = target_area;
-    tv.stretch_l2[t] = std::sqrt(0.5 * sum_sq);
-
-    // A triangle shows its face's fold (either triangulation); its own values need an inverse.
-    const bool degenerate = !(prod >= options.degenerate_area_ratio);
-    tv.folded[t] = fv.folded[out.triangle_face[t]];
-
-    // Corner angles (unsigned, in each triangle's own plane).
-    double worst = 0.0;
-    for (int k = 0; k < 3; ++k) {
-      const int a = tri[k], b = tri[(k + 1) % 3], c = tri[(k + 2) % 3];
-      const double src = corner_angle(source.col(a), source.col(b), source.col(c));
-      const double tgt =
-          corner_angle(target_positions.col(a), target_positions.col(b), target_positions.col(c));
-      const double diff = std::abs(tgt - src) * kDeg;
-      worst = std::max(worst, diff);
-      angle_sum += diff;
-      ++angle_count;
-    }
-    tv.angle_error_deg[t] = worst;
-    out.angle_error_max_deg = std::max(out.angle_error_max_deg, worst);
-
-    ++out.measured_triangles;
-    const double w = source_area;
-    w_sum += w;
-    w_stretch += w * 0.5 * sum_sq;
-    max_s1 = std::max(max_s1, s1);
-    if (degenerate) {
-      tv.inverse_stretch_l2[t] = inf;
-      tv.area_distortion[t] = inf;
-      tv.conformal_distortion[t] = inf;
-      tv.symmetric_dirichlet[t] = inf;
-      continue;
-    }
-    // 1/s1^2 + 1/s2^2 = (s1^2 + s2^2) / (s1 s2)^2.
-    const double inv_sum_sq = sum_sq / (prod * prod);
-    tv.inverse_stretch_l2[t] = std::sqrt(0.5 * inv_sum_sq);
-    tv.area_distortion[t] = std::abs(std::log(prod));
-    tv.conformal_distortion[t] = s1 / s2;
-    tv.symmetric_dirichlet[t] = sum_sq + inv_sum_sq;
-    w_regular += w;
-    w_area += w * tv.area_distortion[t];
-    w_conf += w * tv.conformal_distortion[t];
-    w_sd += w * tv.symmetric_dirichlet[t];
-    // The inverse map's domain is the target triangle: weight by its area.
-    w_inv_sum += target_area;
-    w_inv_stretch += target_area * 0.5 * inv_sum_sq;
-    max_inv = std::max(max_inv, 1.0 / s2);
+    measure_triangle(t, source, target_positions, options, name, out, sums);
   }
-
-  if (w_sum > 0.0) {
-    out.stretch_l2 = std::sqrt(w_stretch / w_sum);
-    out.stretch_linf = max_s1;
-  }
-  // Degenerate triangles have no finite value in these means: they are left out (and counted in
-  // `folds` and `degenerate`).
-  if (w_regular > 0.0) {
-    out.inverse_stretch_linf = max_inv;
-    out.area_distortion = w_area / w_regular;
-    out.conformal_distortion = w_conf / w_regular;
-    out.symmetric_dirichlet = w_sd / w_regular;
-  }
-  if (w_inv_sum > 0.0) {
-    out.inverse_stretch_l2 = std::sqrt(w_inv_stretch / w_inv_sum);
-  }
-  if (angle_count > 0) {
-    out.angle_error_mean_deg = angle_sum / static_cast<double>(angle_count);
-  }
-  out.folds = have_normals ? folds : -1;
+  aggregate(sums, out);
+  out.folds = options.target_normals.cols() > 0 ? folds : -1;
   return out;
 }
 

@@ -250,7 +250,7 @@ RelaxationResult relax_lbfgs(const RelaxationProblem& problem, const RelaxationO
   Pair next;        // storage of the next (s, y) pair; the oldest pair's once the memory is full
   int stalled = 0;  // consecutive steps that changed the energy by less than its round-off
   // Tangent frames (du, dv) of the interior particles at their current and trial surface points.
-  std::vector<solver_detail::TangentFrame> frames, trial_frames;
+  std::vector<SurfaceDerivatives> frames, trial_frames;
   assign_huge(frames, static_cast<std::size_t>(n));
   assign_huge(trial_frames, static_cast<std::size_t>(n));
   for_chunks(
@@ -376,7 +376,7 @@ RelaxationResult relax_lbfgs(const RelaxationProblem& problem, const RelaxationO
             const auto p = static_cast<std::size_t>(setup.interior[kk]);
             const auto col = static_cast<Eigen::Index>(p);
             const Eigen::Vector3d step = alpha * layout.at(direction, k);
-            solver_detail::TangentFrame& frame = trial_frames[kk];
+            SurfaceDerivatives& frame = trial_frames[kk];
             if (step.isZero(0.0)) {  // blocked (or converged) particle: exactly where it is
               trial_points[p] = setup.points[p];
               trial_positions.col(col) = setup.positions.col(col);

@@ -15,10 +15,7 @@ constexpr double kDegenerateFrame = 1e-6;
 
 }  // namespace
 
-TangentFrame tangent_frame(const SurfaceDerivatives& d) {
-  return d;
-}
-TangentFrame tangent_frame(const LimitSurface& surface, const SurfacePoint& point) {
+SurfaceDerivatives tangent_frame(const LimitSurface& surface, const SurfacePoint& point) {
   return surface.derivatives(point);
 }
 
@@ -40,8 +37,9 @@ TangentFrame tangent_frame(const LimitSurface& surface, const SurfacePoint& poin
 // leaving the magnet to the caller, when the parameterisation is degenerate, the walk stops on the
 // surface boundary, or the corrections do not converge.
 bool parametric_retraction(const LimitSurface& surface, const SurfacePoint& from,
-                           const Eigen::Vector3d& x, const TangentFrame& frame,
-                           const Eigen::Vector3d& t, ClosestPoint& out, TangentFrame& out_frame) {
+                           const Eigen::Vector3d& x, const SurfaceDerivatives& frame,
+                           const Eigen::Vector3d& t, ClosestPoint& out,
+                           SurfaceDerivatives& out_frame) {
   Eigen::Vector2d first;
   if (!pull_back(frame.du, frame.dv, t, first)) {
     return false;

@@ -11,13 +11,10 @@
 
 namespace elastic::solver_detail {
 
-/// The parameter-space frame of a surface point, its first and second derivatives with respect to
-/// the ptex (u, v): the surface's own SurfaceDerivatives (the position is carried along). The one
-/// type named TangentFrame is the orthonormal frame of transfer/tangent_frames.h; this is a
-/// solver-local name kept for the L-BFGS solver's code.
-using TangentFrame = SurfaceDerivatives;
-TangentFrame tangent_frame(const SurfaceDerivatives& d);
-TangentFrame tangent_frame(const LimitSurface& surface, const SurfacePoint& point);
+/// The parameter-space frame the retraction reads at a surface point: the surface's own
+/// SurfaceDerivatives there (first and second derivatives with respect to the ptex (u, v); the
+/// position is carried along).
+SurfaceDerivatives tangent_frame(const LimitSurface& surface, const SurfacePoint& point);
 
 /// The fast solver's retraction: moves the surface point `from` (limit position `x`, frame
 /// `frame`) by the tangent step `t` along the surface. The step is pulled back into ptex
@@ -31,7 +28,8 @@ TangentFrame tangent_frame(const LimitSurface& surface, const SurfacePoint& poin
 /// parameterisation is degenerate, the walk stops on the surface boundary, or three corrections do
 /// not reach the tolerance.
 bool parametric_retraction(const LimitSurface& surface, const SurfacePoint& from,
-                           const Eigen::Vector3d& x, const TangentFrame& frame,
-                           const Eigen::Vector3d& t, ClosestPoint& out, TangentFrame& out_frame);
+                           const Eigen::Vector3d& x, const SurfaceDerivatives& frame,
+                           const Eigen::Vector3d& t, ClosestPoint& out,
+                           SurfaceDerivatives& out_frame);
 
 }  // namespace elastic::solver_detail

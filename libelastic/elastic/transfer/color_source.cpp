@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "elastic/core/error.h"
+#include "elastic/mesh/default_material.h"
 #include "elastic/regions/texture_coordinates.h"
 
 namespace elastic {
@@ -94,12 +95,7 @@ ColorSource ColorSource::texture(const LimitSurface& surface, const std::filesys
   }
   std::filesystem::path path = image;
   if (path.empty()) {
-    for (const Material& m : surface.control_mesh().materials) {
-      if (!m.diffuse_texture.empty()) {
-        path = m.diffuse_texture;
-        break;
-      }
-    }
+    path = first_diffuse_texture(surface.control_mesh());
     if (path.empty()) {
       throw InvalidInputError(surface.name(),
                               "has no material with a diffuse texture (map_Kd); give an image");

@@ -9,6 +9,7 @@
 #include <utility>
 
 #include "elastic/core/error.h"
+#include "elastic/regions/texture_coordinates.h"
 
 namespace elastic {
 
@@ -77,8 +78,7 @@ std::vector<double> heights_from_image(const Image& image, std::span<const Eigen
     double value = 0.0;
     switch (options.channel) {
       case HeightChannel::Luminance:
-        value = 0.2126 * static_cast<double>(c[0]) + 0.7152 * static_cast<double>(c[1]) +
-                0.0722 * static_cast<double>(c[2]);
+        value = luminance(c);
         break;
       case HeightChannel::Red:
         value = static_cast<double>(c[0]);
@@ -219,6 +219,53 @@ DisplacementResult displace_along_normals(std::span<const Eigen::Vector3d> posit
     result.max_displacement = std::max(result.max_displacement, offset.norm());
   }
   return result;
+}
+
+std::vector<double> sample_heights_from_image(const TargetSamples& samples,
+                                              const LimitSurface& source, const Image& image,
+                                              const HeightImageOptions& options) {
+  if (!source.control_mesh().has_texcoords()) {
+    throw InvalidInputError(source.name(), "has no texture coordinates to look up a height image");
+  }
+  std::vector<double> heights(static_cast<size_t>(samples.num_vertices()),
+                              std::numeric_limits<double>::quiet_NaN());
+  std::vector<Eigen::Vector2d> uv;
+  std::vector<int> index;
+  for (int i = 0; i < samples.num_vertices(); ++i) {
+    if (!samples.sources[static_cast<size_t>(i)].inside) continue;
+    uv.push_back(texture_coordinate(source, samples.sources[static_cast<size_t>(i)].point));
+    index.push_back(i);
+  }
+  const std::vector<double> h = heights_from_image(image, uv, options);
+  for (size_t k = 0; k < index.size(); ++k) heights[static_cast<size_t>(index[k])] = h[k];
+  return heights;
+}
+
+std::vector<double> sample_heights_from_colors(const TargetSamples& samples,
+                                               const ColorSource& colors, double zero_level) {
+  std::vector<double> heights(static_cast<size_t>(samples.num_vertices()),
+                              std::numeric_limits<double>::quiet_NaN());
+  for (int i = 0; i < samples.num_vertices(); ++i) {
+    const Mapping::Location& source = samples.sources[static_cast<size_t>(i)];
+    if (!source.inside) continue;
+    heights[static_cast<size_t>(i)] = luminance(colors.color(source.point)) - zero_level;
+  }
+  return heights;
+}
+
+DisplacedPaintedSurface displace_painted_surface(const PaintedSurface& painted,
+                                                 std::span<const double> heights,
+                                                 const DisplacementOptions& options) {
+  const TargetSamples& samples = painted.samples;
+  DisplacedPaintedSurface out;
+  out.displacement = displace_along_normals(samples.positions, samples.normals, heights,
+                                            samples.triangles, options);
+  out.positions = painted.positions;
+  for (int j = 0; j < samples.num_vertices(); ++j) {
+    out.positions[static_cast<size_t>(painted.sample_vertex_index[static_cast<size_t>(j)])] =
+        out.displacement.positions[static_cast<size_t>(j)];
+  }
+  return out;
 }
 
 }  // namespace elastic

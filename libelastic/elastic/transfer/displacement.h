@@ -16,6 +16,11 @@
 ///
 /// Heights are in the units the caller chooses; `scale` turns them into the target's length units
 /// (e.g. image values in [0, 1] times a relief depth in model units).
+///
+/// On a painted target (painted_surface.h) the heights come per refined region vertex from its
+/// source point: sample_heights_from_image() and sample_heights_from_colors(); and
+/// displace_painted_surface() moves the region of the painted mesh (the displaced mesh of
+/// `elastic paste --height`, transfer/paste.h).
 
 #include <Eigen/Core>
 #include <span>
@@ -23,6 +28,10 @@
 #include <vector>
 
 #include "elastic/image/image.h"
+#include "elastic/surface/limit_surface.h"
+#include "elastic/transfer/color_source.h"
+#include "elastic/transfer/painted_surface.h"
+#include "elastic/transfer/target_samples.h"
 
 namespace elastic {
 
@@ -34,6 +43,13 @@ enum class HeightChannel {
   Blue,
   Alpha
 };
+
+/// Rec. 709 luma of an RGBA colour's stored values, 0.2126 R + 0.7152 G + 0.0722 B (alpha
+/// ignored): the height a luminance reads.
+inline double luminance(const Eigen::Vector4f& rgba) {
+  return 0.2126 * static_cast<double>(rgba[0]) + 0.7152 * static_cast<double>(rgba[1]) +
+         0.0722 * static_cast<double>(rgba[2]);
+}
 
 struct HeightImageOptions {
   /// The channel read as height.
@@ -50,6 +66,20 @@ struct HeightImageOptions {
 /// not finite (naming "height image").
 std::vector<double> heights_from_image(const Image& image, std::span<const Eigen::Vector2d> uv,
                                        const HeightImageOptions& options = {});
+
+/// One height per vertex of a refined target region: `image` (heights_from_image with `options`)
+/// looked up at the texture coordinate of the vertex's source point on `source` (the surface the
+/// samples' sources lie on); NaN for vertices without a source.
+/// \throws InvalidInputError naming the source when it has no texture coordinates; as
+///         heights_from_image.
+std::vector<double> sample_heights_from_image(const TargetSamples& samples,
+                                              const LimitSurface& source, const Image& image,
+                                              const HeightImageOptions& options = {});
+
+/// One height per vertex of a refined target region: the luminance() of the source colour at the
+/// vertex's source point minus `zero_level`; NaN for vertices without a source.
+std::vector<double> sample_heights_from_colors(const TargetSamples& samples,
+                                               const ColorSource& colors, double zero_level = 0.0);
 
 struct DisplacementOptions {
   /// Multiplies every height (height units -> target length units).
@@ -87,6 +117,24 @@ DisplacementResult displace_along_normals(std::span<const Eigen::Vector3d> posit
                                           std::span<const double> heights,
                                           std::span<const Eigen::Vector3i> triangles,
                                           const DisplacementOptions& options = {});
+
+/// A painted target with its region displaced.
+struct DisplacedPaintedSurface {
+  /// #V positions of the painted mesh (PaintedSurface::positions): the region's vertices displaced,
+  /// the rest as painted.
+  std::vector<Eigen::Vector3d> positions;
+  DisplacementResult displacement;  ///< the region's displacement (per refined region vertex)
+};
+
+/// Displaces the refined region of `painted` (its TargetSamples: positions, limit normals,
+/// triangles) along the target normals by `heights` (one per region vertex, e.g.
+/// sample_heights_from_image) with displace_along_normals, and puts the moved vertices into the
+/// painted mesh's positions. Write it with make_target_mesh(painted, positions) (the target's own
+/// texture coordinates and materials on the displaced positions).
+/// \throws InvalidInputError as displace_along_normals.
+DisplacedPaintedSurface displace_painted_surface(const PaintedSurface& painted,
+                                                 std::span<const double> heights,
+                                                 const DisplacementOptions& options = {});
 
 /// Distance from every vertex to the boundary of a triangle mesh (the union of its boundary edges):
 /// Euclidean distance to the nearest boundary edge, where "nearest" is found by propagating the

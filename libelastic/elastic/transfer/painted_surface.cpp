@@ -18,6 +18,126 @@
 
 namespace elastic {
 
+namespace {
+
+using SegmentPoints = std::map<std::pair<int, int>, std::vector<int>>;
+
+// Vertices: every vertex of the cut tessellation, then the refinement's new vertices; each region
+// vertex knows its sample and each sample its vertex.
+void add_vertices(PaintedSurface& out, SurfacePartition& part) {
+  const TargetSamples& s = out.samples;
+  out.positions = std::move(part.positions);
+  out.points = std::move(part.points);
+  out.vertex_sample.assign(out.positions.size(), -1);
+  const int coarse = part.inside.num_vertices();
+  out.sample_vertex_index.resize(static_cast<size_t>(s.num_vertices()));
+  for (int j = 0; j < s.num_vertices(); ++j) {
+    int g;
+    if (j < coarse) {
+      g = part.inside_vertices[static_cast<size_t>(j)];
+    } else {
+      g = static_cast<int>(out.positions.size());
+      out.positions.push_back(s.positions[static_cast<size_t>(j)]);
+      out.points.push_back(s.points[static_cast<size_t>(j)]);
+      out.vertex_sample.push_back(-1);
+    }
+    out.sample_vertex_index[static_cast<size_t>(j)] = g;
+    out.vertex_sample[static_cast<size_t>(g)] = j;
+  }
+}
+
+// The new vertices on each coarse boundary segment (a -> b along the inside's loop), in order.
+// The refinement keeps the coarse vertices (indices < coarse) on the loop, 2^levels - 1 new ones
+// between consecutive ones, at equal steps in (u, v).
+SegmentPoints boundary_segment_points(const PaintedSurface& out, int coarse) {
+  const TargetSamples& s = out.samples;
+  SegmentPoints segment_points;
+  if (s.levels == 0 || s.boundary.empty()) {
+    return segment_points;
+  }
+  const size_t n = s.boundary.size();
+  size_t first = 0;
+  while (first < n && s.boundary[first] >= coarse) {
+    ++first;
+  }
+  for (size_t k = 0; k < n && first < n; ++k) {
+    const size_t i = (first + k) % n;
+    if (s.boundary[i] >= coarse) {
+      continue;
+    }
+    std::vector<int> between;
+    size_t j = (i + 1) % n;
+    while (s.boundary[j] >= coarse) {
+      between.push_back(out.sample_vertex_index[static_cast<size_t>(s.boundary[j])]);
+      j = (j + 1) % n;
+    }
+    const int a = out.sample_vertex_index[static_cast<size_t>(s.boundary[i])];
+    const int b = out.sample_vertex_index[static_cast<size_t>(s.boundary[j])];
+    if (!between.empty()) {
+      segment_points[{a, b}] = std::move(between);
+    }
+  }
+  return segment_points;
+}
+
+void add_triangle(PaintedSurface& out, const Eigen::Vector3i& t, int face,
+                  const std::array<Eigen::Vector2d, 3>& uv, bool inside) {
+  out.triangles.push_back(t);
+  out.triangle_face.push_back(face);
+  out.triangle_uv.push_back(uv);
+  out.triangle_inside.push_back(inside ? 1 : 0);
+}
+
+// One outside triangle (corners c at (u, v) `uv` in ptex face `face`): as it is, or, when refined
+// boundary points lie on its edges, fanned from its (u, v) centroid through them.
+void add_outside_triangle(PaintedSurface& out, const LimitSurface& target,
+                          const SegmentPoints& segment_points, const Eigen::Vector3i& c,
+                          const std::array<Eigen::Vector2d, 3>& uv, int face) {
+  // The polygon of the triangle with the refined boundary points on its edges. Edge (p, q) of an
+  // outside triangle borders the region when (q, p) is a boundary segment of the inside.
+  std::vector<int> poly;
+  std::vector<Eigen::Vector2d> poly_uv;
+  for (int k = 0; k < 3; ++k) {
+    const int p = c[k], q = c[(k + 1) % 3];
+    const Eigen::Vector2d& up = uv[static_cast<size_t>(k)];
+    const Eigen::Vector2d& uq = uv[static_cast<size_t>((k + 1) % 3)];
+    poly.push_back(p);
+    poly_uv.push_back(up);
+    const auto it = segment_points.find({q, p});
+    if (it == segment_points.end()) {
+      continue;
+    }
+    // Listed from q to p; the m-th from p is at fraction (m + 1) / (count + 1) of p -> q, since
+    // the splits are at equal (u, v) steps and ptex faces meet by affine maps along edges.
+    const std::vector<int>& between = it->second;
+    const int count = static_cast<int>(between.size());
+    for (int m = 0; m < count; ++m) {
+      const double f = static_cast<double>(m + 1) / (count + 1);
+      poly.push_back(between[static_cast<size_t>(count - 1 - m)]);
+      poly_uv.push_back((1.0 - f) * up + f * uq);
+    }
+  }
+  if (poly.size() == 3) {
+    add_triangle(out, c, face, uv, false);
+    return;
+  }
+  // Fan from the (u, v) centroid: the polygon is the triangle with extra points on its edges, so
+  // it is star-shaped from there and every fan triangle keeps the orientation.
+  const Eigen::Vector2d centre = (uv[0] + uv[1] + uv[2]) / 3.0;
+  const SurfacePoint cp{face, centre.x(), centre.y()};
+  const int ci = static_cast<int>(out.positions.size());
+  out.positions.push_back(target.position(cp));
+  out.points.push_back(cp);
+  out.vertex_sample.push_back(-1);
+  for (size_t k = 0; k < poly.size(); ++k) {
+    const size_t l = (k + 1) % poly.size();
+    add_triangle(out, Eigen::Vector3i(poly[k], poly[l], ci), face, {poly_uv[k], poly_uv[l], centre},
+                 false);
+  }
+}
+
+}  // namespace
+
 PaintedSurface paint_surface(const LimitSurface& target, const Region& target_region,
                              const Mapping& mapping, const PaintedSurfaceOptions& options) {
   if (options.resolution < 1 || options.resolution > 1024) {
@@ -38,114 +158,21 @@ PaintedSurface paint_surface(const LimitSurface& target, const Region& target_re
   sampling.name = options.name;
   out.samples = sample_target(part.inside, mapping, sampling);
   const TargetSamples& s = out.samples;
-
-  // Vertices: every vertex of the cut tessellation, then the refinement's new vertices.
-  out.positions = std::move(part.positions);
-  out.points = std::move(part.points);
-  out.vertex_sample.assign(out.positions.size(), -1);
   const int coarse = part.inside.num_vertices();
-  out.sample_vertex_index.resize(static_cast<size_t>(s.num_vertices()));
-  for (int j = 0; j < s.num_vertices(); ++j) {
-    int g;
-    if (j < coarse) {
-      g = part.inside_vertices[static_cast<size_t>(j)];
-    } else {
-      g = static_cast<int>(out.positions.size());
-      out.positions.push_back(s.positions[static_cast<size_t>(j)]);
-      out.points.push_back(s.points[static_cast<size_t>(j)]);
-      out.vertex_sample.push_back(-1);
-    }
-    out.sample_vertex_index[static_cast<size_t>(j)] = g;
-    out.vertex_sample[static_cast<size_t>(g)] = j;
-  }
-
-  // The new vertices on each coarse boundary segment (a -> b along the inside's loop), in order.
-  // The refinement keeps the coarse vertices (indices < coarse) on the loop, 2^levels - 1 new ones
-  // between consecutive ones, at equal steps in (u, v).
-  std::map<std::pair<int, int>, std::vector<int>> segment_points;
-  if (s.levels > 0 && !s.boundary.empty()) {
-    const size_t n = s.boundary.size();
-    size_t first = 0;
-    while (first < n && s.boundary[first] >= coarse) {
-      ++first;
-    }
-    for (size_t k = 0; k < n && first < n; ++k) {
-      const size_t i = (first + k) % n;
-      if (s.boundary[i] >= coarse) {
-        continue;
-      }
-      std::vector<int> between;
-      size_t j = (i + 1) % n;
-      while (s.boundary[j] >= coarse) {
-        between.push_back(out.sample_vertex_index[static_cast<size_t>(s.boundary[j])]);
-        j = (j + 1) % n;
-      }
-      const int a = out.sample_vertex_index[static_cast<size_t>(s.boundary[i])];
-      const int b = out.sample_vertex_index[static_cast<size_t>(s.boundary[j])];
-      if (!between.empty()) {
-        segment_points[{a, b}] = std::move(between);
-      }
-    }
-  }
-
-  auto add = [&](const Eigen::Vector3i& t, int face, const std::array<Eigen::Vector2d, 3>& uv,
-                 bool inside) {
-    out.triangles.push_back(t);
-    out.triangle_face.push_back(face);
-    out.triangle_uv.push_back(uv);
-    out.triangle_inside.push_back(inside ? 1 : 0);
-  };
+  add_vertices(out, part);
+  const SegmentPoints segment_points = boundary_segment_points(out, coarse);
   for (size_t t = 0; t < part.outside_triangles.size(); ++t) {
-    const Eigen::Vector3i& c = part.outside_triangles[t];
-    const auto& uv = part.outside_uv[t];
-    const int face = part.outside_face[t];
-    // The polygon of the triangle with the refined boundary points on its edges. Edge (p, q) of an
-    // outside triangle borders the region when (q, p) is a boundary segment of the inside.
-    std::vector<int> poly;
-    std::vector<Eigen::Vector2d> poly_uv;
-    for (int k = 0; k < 3; ++k) {
-      const int p = c[k], q = c[(k + 1) % 3];
-      const Eigen::Vector2d& up = uv[static_cast<size_t>(k)];
-      const Eigen::Vector2d& uq = uv[static_cast<size_t>((k + 1) % 3)];
-      poly.push_back(p);
-      poly_uv.push_back(up);
-      const auto it = segment_points.find({q, p});
-      if (it == segment_points.end()) {
-        continue;
-      }
-      // Listed from q to p; the m-th from p is at fraction (m + 1) / (count + 1) of p -> q, since
-      // the splits are at equal (u, v) steps and ptex faces meet by affine maps along edges.
-      const std::vector<int>& between = it->second;
-      const int count = static_cast<int>(between.size());
-      for (int m = 0; m < count; ++m) {
-        const double f = static_cast<double>(m + 1) / (count + 1);
-        poly.push_back(between[static_cast<size_t>(count - 1 - m)]);
-        poly_uv.push_back((1.0 - f) * up + f * uq);
-      }
-    }
-    if (poly.size() == 3) {
-      add(c, face, uv, false);
-      continue;
-    }
-    // Fan from the (u, v) centroid: the polygon is the triangle with extra points on its edges, so
-    // it is star-shaped from there and every fan triangle keeps the orientation.
-    const Eigen::Vector2d centre = (uv[0] + uv[1] + uv[2]) / 3.0;
-    const SurfacePoint cp{face, centre.x(), centre.y()};
-    const int ci = static_cast<int>(out.positions.size());
-    out.positions.push_back(target.position(cp));
-    out.points.push_back(cp);
-    out.vertex_sample.push_back(-1);
-    for (size_t k = 0; k < poly.size(); ++k) {
-      const size_t l = (k + 1) % poly.size();
-      add(Eigen::Vector3i(poly[k], poly[l], ci), face, {poly_uv[k], poly_uv[l], centre}, false);
-    }
+    add_outside_triangle(out, target, segment_points, part.outside_triangles[t], part.outside_uv[t],
+                         part.outside_face[t]);
   }
   for (int t = 0; t < s.num_triangles(); ++t) {
     const Eigen::Vector3i& c = s.triangles[static_cast<size_t>(t)];
-    add(Eigen::Vector3i(out.sample_vertex_index[static_cast<size_t>(c[0])],
-                        out.sample_vertex_index[static_cast<size_t>(c[1])],
-                        out.sample_vertex_index[static_cast<size_t>(c[2])]),
-        s.triangle_face[static_cast<size_t>(t)], s.triangle_uv[static_cast<size_t>(t)], true);
+    add_triangle(out,
+                 Eigen::Vector3i(out.sample_vertex_index[static_cast<size_t>(c[0])],
+                                 out.sample_vertex_index[static_cast<size_t>(c[1])],
+                                 out.sample_vertex_index[static_cast<size_t>(c[2])]),
+                 s.triangle_face[static_cast<size_t>(t)], s.triangle_uv[static_cast<size_t>(t)],
+                 true);
   }
   return out;
 }
