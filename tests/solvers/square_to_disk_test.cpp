@@ -222,6 +222,49 @@ TEST(SquareToDisk, RestartFromEquilibriumWithTheFirstReferenceIsConverged) {
   EXPECT_EQ((second.positions - first.positions).cwiseAbs().maxCoeff(), 0.0);
 }
 
+// C_a in effect: the paper's energy and the faithful solver keep C_a = C, the robust energy softens
+// it to kRobustAngularStiffness C; a value set by the caller always wins.
+TEST(AngularStiffness, DefaultsPerEnergyAndOverride) {
+  RelaxationOptions options;
+  options.stiffness = 2.0;
+  EXPECT_EQ(angular_stiffness(options), 2.0 * kRobustAngularStiffness);
+  options.energy = EnergyKind::Paper;
+  EXPECT_EQ(angular_stiffness(options), 2.0 * kPaperAngularStiffness);
+  options.energy = EnergyKind::Robust;
+  options.solver = SolverKind::Faithful;
+  EXPECT_EQ(angular_stiffness(options), 2.0 * kPaperAngularStiffness);
+  options.angular_stiffness = 0.7;
+  EXPECT_EQ(angular_stiffness(options), 0.7);
+}
+
+// Why the robust default is softer: the square's corners must open onto the cap's round boundary,
+// and stiff angular springs hold the map away from the length energy's minimum there. With the
+// robust default the relaxed map's length energy (eq. 13, the spring sum over sigma k, measured
+// here from the positions) is lower than with C_a = C, with the reported C_a.
+TEST(AngularStiffness, RobustDefaultKeepsLengthsBetterOnASquareIntoADisk) {
+  const ShapeOptions shape{.faces = ShapeFaces::Quads, .resolution = 16, .scale = 1.0};
+  const NaiveProblem naive(shape, make_cap(shape), "boundary", 500, false);
+  const auto length_error = [&](const Eigen::Matrix3Xd& x) {
+    double error = 0.0, total = 0.0;
+    for (const Spring& s : naive.grid.springs) {
+      const double rest = naive.problem.rest_scale * s.rest;
+      error += std::pow((x.col(s.j) - x.col(s.i)).norm() - rest, 2);
+      total += rest * rest;
+    }
+    return error / total;
+  };
+  const RelaxationResult soft = relax(naive.problem, RelaxationOptions{});
+  RelaxationOptions stiff_options;
+  stiff_options.angular_stiffness = 1.0;
+  const RelaxationResult stiff = relax(naive.problem, stiff_options);
+  ASSERT_TRUE(soft.converged) << to_string(soft.reason);
+  ASSERT_TRUE(stiff.converged) << to_string(stiff.reason);
+  EXPECT_EQ(soft.angular_stiffness, kRobustAngularStiffness);
+  EXPECT_EQ(stiff.angular_stiffness, 1.0);
+  EXPECT_EQ(soft.folded_faces, 0);
+  EXPECT_LT(length_error(soft.positions), 0.95 * length_error(stiff.positions));
+}
+
 // The goblet's squeezed stem with the robust energy: the folded start is untangled with the
 // paper's energy first (the barrier cannot cross a fold), then the barrier run converges fold-free.
 TEST(Untangle, RobustEnergyUntanglesThenConvergesOnTheGoblet) {

@@ -166,7 +166,7 @@ struct RelaxationOptions {
   double barrier_stiffness = 1.0;
   /// Smaller stretch below which the barrier acts (SpringEnergyOptions::barrier_sigma).
   double barrier_sigma = 0.4;
-  double stiffness = 1.0;          ///< C of the normal springs (eq. 13)
+  double stiffness = 1.0;  ///< C of the normal springs (eq. 13)
   /// C_a of the angular springs; empty: the energy's default (kPaperAngularStiffness or
   /// kRobustAngularStiffness times `stiffness`), see angular_stiffness(const RelaxationOptions&).
   std::optional<double> angular_stiffness;
