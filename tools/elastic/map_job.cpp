@@ -100,9 +100,10 @@ void add_map_flags(CLI::App& sub, MapJob& a) {
                  "(the paper's springs alone, as in Table 1)")
       ->check(CLI::IsMember({"robust", "paper"}));
   sub.add_option("--angular-stiffness", a.angular_stiffness,
-                 "Stiffness of the angular springs relative to the normal springs (default: 0.3 "
-                 "with --energy robust, 1 with --energy paper or --solver explicit)")
-      ->check(CLI::Range(0.0, 100.0));
+                 "auto (default: 0.3 with --energy robust, 1 with --energy paper or --solver "
+                 "explicit) or the stiffness of the angular springs relative to the normal "
+                 "springs, 0..100")
+      ->check(CLI::IsMember({"auto"}) | CLI::Range(0.0, 100.0));
   sub.add_option("--scheme", a.scheme, "Subdivision scheme for both meshes")
       ->check(CLI::IsMember({"auto", "loop", "catmull-clark"}));
   sub.add_option("--subdivide", a.subdivide,
@@ -143,7 +144,9 @@ MapOptions make_map_options(const MapJob& job, const ProgressCallback& progress)
       parse_preconditioner(job.preconditioner, "--preconditioner");
   options.relaxation.threads = job.threads;
   options.relaxation.max_iterations = job.max_iterations;
-  if (job.angular_stiffness >= 0.0) options.relaxation.angular_stiffness = job.angular_stiffness;
+  if (job.angular_stiffness != "auto") {
+    options.relaxation.angular_stiffness = std::stod(job.angular_stiffness);  // checked: 0..100
+  }
   options.subdivisions = job.subdivide;
   options.progress = progress;
   options.relaxation.progress = progress;

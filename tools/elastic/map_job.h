@@ -39,7 +39,7 @@ struct MapJob {
   std::string preconditioner = "multigrid";  ///< --preconditioner multigrid|direct (lbfgs)
   std::string rest_scale = "auto";           ///< --rest-scale auto|boundary|area|none
   std::string energy = "robust";             ///< --energy robust|paper
-  double angular_stiffness = -1.0;           ///< --angular-stiffness C_a / C (< 0: the default)
+  std::string angular_stiffness = "auto";    ///< --angular-stiffness auto|C_a / C
   std::string boundary_offset = "auto";      ///< --boundary-offset auto|anchor
   std::string boundary = "auto";             ///< --boundary auto|fixed|slide
   std::string scheme = "auto";               ///< --scheme auto|loop|catmull-clark

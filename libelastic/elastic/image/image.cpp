@@ -128,7 +128,19 @@ std::optional<std::string> png_without_empty_idat(const std::filesystem::path& p
   if (!in.read(bytes.data(), kSignatureSize) || bytes != std::string_view(kSignature)) {
     return std::nullopt;
   }
-  bytes.append(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  // The rest by its size (GCC 12 warns on istreambuf_iterator's inlined null check, a false
+  // positive of -Wnull-dereference).
+  in.seekg(0, std::ios::end);
+  const std::streamoff size = in.tellg();
+  if (size < static_cast<std::streamoff>(kSignatureSize)) {
+    return std::nullopt;
+  }
+  bytes.resize(static_cast<size_t>(size));
+  in.seekg(static_cast<std::streamoff>(kSignatureSize));
+  if (!in.read(bytes.data() + kSignatureSize,
+               static_cast<std::streamsize>(bytes.size() - kSignatureSize))) {
+    return std::nullopt;
+  }
   const auto big_endian = [&bytes](size_t at) {
     std::uint32_t value = 0;
     for (size_t i = 0; i < 4; ++i) value = (value << 8) | static_cast<unsigned char>(bytes[at + i]);
