@@ -117,9 +117,8 @@ void carry_over(const fs::path& from, const fs::path& to) {
     const fs::path target = to / name;
     std::error_code ec;
     if (fs::symlink_status(target, ec).type() != fs::file_type::not_found) {
-      const bool both_folders = entry.is_directory() && !entry.is_symlink() &&
-                                fs::is_directory(fs::symlink_status(target, ec));
-      if (both_folders) carry_over(entry.path(), target);  // e.g. frames/: keep the others' too
+      // The run wrote this name: its file, or its whole folder (frames/ of a run with fewer
+      // frames must not keep an earlier run's last frames: that would be a mixture of two sets).
       continue;
     }
     if (entry.is_symlink()) {

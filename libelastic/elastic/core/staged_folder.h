@@ -11,7 +11,9 @@
 ///
 /// - Files in the destination that the run does not write (the user's own, or an earlier run's
 ///   with other flags) are carried into the new set as hard links (copies where links fail), so a
-///   commit never loses them; temporaries of write_file_atomically are not carried.
+///   commit never loses them; temporaries of write_file_atomically are not carried. A folder the
+///   run writes (a paste's frames/) is the run's whole: nothing of the old folder of that name is
+///   carried into it, so an earlier run's extra frames never mix with the new ones.
 /// - Where the file system cannot exchange folders, commit() renames the destination to
 ///   `.<name>.old.<PID>`, the staging folder to the destination, and removes the old one; a run
 ///   killed between the two renames leaves the old set under the `.old.` name, which the next run
