@@ -358,7 +358,8 @@ TEST(Relaxation, InteriorLaplacianIsTheQuadraticFormOfTheSprings) {
     for (const Spring& s : grid.springs)
       form += options.stiffness * std::pow(value(s.i) - value(s.j), 2);
     for (const AngularSpring& s : grid.angular_springs)
-      form += *options.angular_stiffness * std::pow(value(s.i) - 0.5 * (value(s.a) + value(s.b)), 2);
+      form +=
+          *options.angular_stiffness * std::pow(value(s.i) - 0.5 * (value(s.a) + value(s.b)), 2);
     // v^T L v from the lower triangle: diagonal once, off-diagonal entries twice.
     double quadratic = 0.0;
     for (Eigen::Index c = 0; c < lower.outerSize(); ++c)
