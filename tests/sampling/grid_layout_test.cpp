@@ -192,6 +192,19 @@ TEST(GridLayout, FacesValidOnPlaneAndBump) {
   expect_valid_faces(layout_particle_grid(region, options).grid, bump, 0.05);
 }
 
+// Faces none of whose corners is free (the band guarantee says there are none).
+int faces_with_only_boundary_corners(const ParticleGrid& grid) {
+  int count = 0;
+  for (const auto fh : grid.mesh.faces()) {
+    bool free_corner = false;
+    for (const auto vh : grid.mesh.fv_range(fh)) {
+      free_corner = free_corner || !grid.is_boundary[static_cast<size_t>(vh.idx())];
+    }
+    count += free_corner ? 0 : 1;
+  }
+  return count;
+}
+
 // docs/sampling.md's guarantee: every face has a corner that can move. The square region's four
 // corners are where the band triangulation alone makes triangles of three boundary particles (the
 // corner particle and its two neighbours); the layout must have added free points there.
@@ -202,15 +215,7 @@ TEST(GridLayout, NoFaceHasEveryCornerOnTheBoundary) {
     options.particles = n;
     const GridLayoutResult layout = layout_particle_grid(plane.region, options);
     const ParticleGrid& grid = layout.grid;
-    int all_boundary = 0;
-    for (const auto fh : grid.mesh.faces()) {
-      bool free_corner = false;
-      for (const auto vh : grid.mesh.fv_range(fh)) {
-        free_corner = free_corner || !grid.is_boundary[static_cast<size_t>(vh.idx())];
-      }
-      all_boundary += free_corner ? 0 : 1;
-    }
-    EXPECT_EQ(all_boundary, 0) << "N = " << n;
+    EXPECT_EQ(faces_with_only_boundary_corners(grid), 0) << "N = " << n;
     EXPECT_GE(layout.band_points, 1) << "N = " << n << ": the square's corners need free points";
     EXPECT_EQ(layout.interior_particles + layout.boundary_particles, grid.num_particles());
     expect_valid_faces(grid, plane.surface, 0.05);
@@ -238,15 +243,7 @@ TEST(GridLayout, StarPolygonRegionLaysOut) {
     const GridLayoutResult layout = layout_particle_grid(region, options);
     const ParticleGrid& grid = layout.grid;
     EXPECT_LE(std::abs(layout.count_error), 0.05) << "N = " << n;
-    int all_boundary = 0;
-    for (const auto fh : grid.mesh.faces()) {
-      bool free_corner = false;
-      for (const auto vh : grid.mesh.fv_range(fh)) {
-        free_corner = free_corner || !grid.is_boundary[static_cast<size_t>(vh.idx())];
-      }
-      all_boundary += free_corner ? 0 : 1;
-    }
-    EXPECT_EQ(all_boundary, 0) << "N = " << n;
+    EXPECT_EQ(faces_with_only_boundary_corners(grid), 0) << "N = " << n;
     EXPECT_GE(layout.band_points, 5) << "N = " << n << ": each tip needs free points";
     expect_valid_faces(grid, surface, 0.05);
   }
