@@ -280,7 +280,7 @@ TEST(CliOutputSets, MemoryEstimatesRefuseBeforeTheWorkAndNameTheFlag) {
            "--resolution", "64", "--max-memory", "300", "--out", (dir / "out").string()},
           log);
   EXPECT_EQ(r.code, 65) << r.err;
-  EXPECT_NE(r.err.find("--resolution 64"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("--target-tessellation 64"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(dir / "out"));
   // The paste's estimate needs only the target's control mesh: it refuses before any surface is
   // built, so a source that would not even read is never reached.
@@ -291,7 +291,7 @@ TEST(CliOutputSets, MemoryEstimatesRefuseBeforeTheWorkAndNameTheFlag) {
            (dir / "out").string()},
           log);
   EXPECT_EQ(r.code, 65) << r.err;
-  EXPECT_NE(r.err.find("--resolution 64"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("--target-tessellation 64"), std::string::npos) << r.err;
   EXPECT_EQ(r.err.find("broken.obj"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(dir / "out"));
 }

@@ -265,6 +265,7 @@ TEST(PaintSurface, ClosedTargetStaysClosedAndAreasAddUp) {
   const PaintedSurface painted =
       paint_surface(*pair.target_surface, *pair.to, pair.mapping(), options);
   ASSERT_GE(painted.samples.levels, 1);
+  EXPECT_EQ(painted.resolution, 6);
   std::map<std::pair<int, int>, int> edges;
   for (const Eigen::Vector3i& t : painted.triangles) {
     for (int k = 0; k < 3; ++k)
@@ -291,6 +292,21 @@ TEST(PaintSurface, ClosedTargetStaysClosedAndAreasAddUp) {
                         .norm();
   }
   EXPECT_NEAR(inside, pair.to->area(), 0.01 * pair.to->area());
+}
+
+TEST(PaintSurface, AutoTessellationFollowsTheTargetsSize) {
+  // The default (resolution 0) aims at 2^18 triangles for the whole target, at most 8 segments per
+  // edge: a Loop plane of 2 N^2 triangles needs sqrt(2^18 / (2 N^2)) segments.
+  EXPECT_EQ(kAutoTargetTriangles, 262'144);
+  const LimitSurface coarse(make_plane({.faces = ShapeFaces::Triangles, .resolution = 4}));
+  EXPECT_EQ(auto_target_resolution(coarse), 8);  // sqrt(2^18 / 32) = 90.5, capped
+  const LimitSurface dense(make_plane({.faces = ShapeFaces::Triangles, .resolution = 128}));
+  EXPECT_EQ(auto_target_resolution(dense), 3);  // sqrt(2^18 / 32768) = 2.83
+  // Catmull-Clark quads count two triangles each: 128^2 quads, the same 2.83.
+  const LimitSurface quads(make_plane({.faces = ShapeFaces::Quads, .resolution = 128}));
+  EXPECT_EQ(auto_target_resolution(quads), 3);
+  const LimitSurface huge(make_plane({.faces = ShapeFaces::Quads, .resolution = 300}));
+  EXPECT_EQ(auto_target_resolution(huge), 1);  // sqrt(2^18 / 180,000) = 1.2
 }
 
 TEST(PaintSurface, PartitionSharesTheCurveAndKeepsTheAnchor) {

@@ -40,7 +40,7 @@ struct PasteArgs {
   int texture_resolution = 0;     // --texture-resolution N (0: off)
   long min_vertices = 100'000;    // --min-vertices
   double max_edge = 0.0;          // --max-edge L
-  int resolution = 8;             // --target-tessellation N (old name --resolution)
+  int resolution = 0;             // --target-tessellation N (old name --resolution; 0: auto)
   int max_levels = 8;             // --max-levels
   long max_vertices = 2'000'000;  // --max-vertices
   bool bake = false;              // --bake
@@ -192,9 +192,15 @@ MapJob paste_map_job(const PasteArgs& a) {
   const bool refined_by_edges = a.max_edge > 0.0 || a.texture_resolution > 0;
   job.extra_bytes = kPasteBytesPerVertex *
                     static_cast<double>(refined_by_edges ? a.max_vertices : a.min_vertices);
-  job.extra_bytes_per_target_face =
-      kPasteBytesPerVertex * static_cast<double>(a.resolution) * a.resolution;
-  job.extra_what = "--resolution " + std::to_string(a.resolution) +
+  // Auto: about kAutoTargetTriangles triangles (half as many vertices) over the whole target, or
+  // the control mesh itself at one segment per edge when that is more.
+  const int per_edge = a.resolution > 0 ? a.resolution : 1;
+  if (a.resolution == 0) {
+    job.extra_bytes += kPasteBytesPerVertex * 0.5 * static_cast<double>(kAutoTargetTriangles);
+  }
+  job.extra_bytes_per_target_face = kPasteBytesPerVertex * static_cast<double>(per_edge) * per_edge;
+  job.extra_what = "--target-tessellation " +
+                   (a.resolution > 0 ? std::to_string(a.resolution) : std::string("auto")) +
                    (refined_by_edges ? " --max-vertices " + std::to_string(a.max_vertices)
                                      : " --min-vertices " + std::to_string(a.min_vertices));
   return job;
@@ -219,6 +225,7 @@ struct RelaxationFrames {
 nlohmann::json paste_json(const PasteResult& pasted, double seconds) {
   const TargetSamples& samples = pasted.painted.samples;
   nlohmann::json paste;
+  paste["target_tessellation"] = pasted.painted.resolution;
   paste["levels"] = samples.levels;
   paste["limited"] = samples.limited;
   paste["region_vertices"] = samples.num_vertices();
@@ -474,8 +481,9 @@ ELASTIC_COMMAND(
       // --resolution: the name before 0.2, kept as an alias for one release (docs/cli.md).
       sub.add_option("--target-tessellation,--resolution", a->resolution,
                      "Tessellation of the painted target outside the region: segments per "
-                     "control edge (old name --resolution)")
-          ->check(CLI::Range(1, 1024));
+                     "control edge; 0: auto, about 262,144 triangles for the whole target and at "
+                     "most 8 per edge (old name --resolution)")
+          ->check(CLI::Range(0, 1024));
       sub.add_option("--max-levels", a->max_levels, "Most refinement levels")
           ->check(CLI::Range(0, 12));
       sub.add_option("--min-vertices", a->min_vertices,

@@ -41,9 +41,11 @@ class EdgeIndex {
   std::vector<int64_t> keys_;
 };
 
+}  // namespace
+
 /// The resolution N actually used: options.resolution, or the one nearest to
 /// options.target_triangles; even when there are n-gon sub-faces (so that they get N/2 segments).
-int choose_resolution(const LimitSurface& surface, const TessellationOptions& options) {
+int tessellation_resolution(const LimitSurface& surface, const TessellationOptions& options) {
   const PolygonMesh& mesh = surface.control_mesh();
   const bool loop = surface.triangular_domain();
   // Catmull-Clark ptex faces come in two sizes: a quad's covers a whole control face, an n-gon's
@@ -83,6 +85,8 @@ int choose_resolution(const LimitSurface& surface, const TessellationOptions& op
   }
   return n;
 }
+
+namespace {
 
 /// Builds the tessellation face by face. Samples on control vertices, control edges, n-gon spokes
 /// and n-gon centres are made once and shared by the faces that meet there (their slots hold the
@@ -269,7 +273,7 @@ class Tessellator {
 }  // namespace
 
 LimitTessellation tessellate(const LimitSurface& surface, const TessellationOptions& options) {
-  return Tessellator(surface, choose_resolution(surface, options)).run();
+  return Tessellator(surface, tessellation_resolution(surface, options)).run();
 }
 
 }  // namespace elastic

@@ -40,4 +40,8 @@ struct LimitTessellation {
 /// \throws InvalidInputError when the options are out of range.
 LimitTessellation tessellate(const LimitSurface& surface, const TessellationOptions& options = {});
 
+/// The resolution tessellate() uses for `options` (the same rounding, without tessellating).
+/// \throws InvalidInputError when the options are out of range.
+int tessellation_resolution(const LimitSurface& surface, const TessellationOptions& options);
+
 }  // namespace elastic

@@ -138,14 +138,21 @@ void add_outside_triangle(PaintedSurface& out, const LimitSurface& target,
 
 }  // namespace
 
+int auto_target_resolution(const LimitSurface& target) {
+  const int nearest =
+      tessellation_resolution(target, {.resolution = 1, .target_triangles = kAutoTargetTriangles});
+  return std::min(nearest, kAutoTargetMaxResolution);
+}
+
 PaintedSurface paint_surface(const LimitSurface& target, const Region& target_region,
                              const Mapping& mapping, const PaintedSurfaceOptions& options) {
-  if (options.resolution < 1 || options.resolution > 1024) {
-    throw InvalidInputError(
-        options.name, "resolution " + std::to_string(options.resolution) + " is outside 1..1024");
+  if (options.resolution < 0 || options.resolution > 1024) {
+    throw InvalidInputError(options.name, "resolution " + std::to_string(options.resolution) +
+                                              " is outside 1..1024 (0: auto)");
   }
   TessellationOptions tess_options;
-  tess_options.resolution = options.resolution;
+  tess_options.resolution =
+      options.resolution == 0 ? auto_target_resolution(target) : options.resolution;
   const LimitTessellation tess = tessellate(target, tess_options);
   PartitionOptions part_options;
   part_options.snap = options.snap;
@@ -154,6 +161,7 @@ PaintedSurface paint_surface(const LimitSurface& target, const Region& target_re
 
   PaintedSurface out;
   out.surface = &target;
+  out.resolution = tess.resolution;
   TargetSamplingOptions sampling = options.sampling;
   sampling.name = options.name;
   out.samples = sample_target(part.inside, mapping, sampling);

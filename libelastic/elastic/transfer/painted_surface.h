@@ -36,9 +36,19 @@
 
 namespace elastic {
 
+/// The default tessellation of the painted target outside the region, so that a paste's output
+/// grows with the region and not with the target: the resolution (segments per control edge) whose
+/// whole-target tessellation has about kAutoTargetTriangles triangles, at most
+/// kAutoTargetMaxResolution (a coarse control mesh gets a smooth limit surface, a dense one such as
+/// a 70,000-triangle scan stays at 1 or 2 instead of 64 triangles per face).
+constexpr long kAutoTargetTriangles = 1L << 18;
+constexpr int kAutoTargetMaxResolution = 8;
+int auto_target_resolution(const LimitSurface& target);
+
 struct PaintedSurfaceOptions {
-  /// Target tessellation: segments per control edge (TessellationOptions::resolution), 1..1024.
-  int resolution = 8;
+  /// Target tessellation: segments per control edge (TessellationOptions::resolution), 1..1024;
+  /// 0: auto_target_resolution().
+  int resolution = 0;
   /// Refinement of the region and how its vertices find their source (target_samples.h). Its
   /// `source_region` should be set to the mapped source region.
   TargetSamplingOptions sampling;
@@ -50,6 +60,7 @@ struct PaintedSurfaceOptions {
 
 struct PaintedSurface {
   const LimitSurface* surface = nullptr;  ///< the target (not owned)
+  int resolution = 0;  ///< the target's tessellation outside the region (segments per control edge)
   /// The refined region with its vertices' source locations. Its vertex j is vertex
   /// `sample_vertex_index[j]` of this mesh.
   TargetSamples samples;

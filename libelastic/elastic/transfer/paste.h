@@ -66,8 +66,10 @@ struct PasteOptions {
   /// Limits for every image the paste reads (texture, bake texture, height image).
   ImageReadOptions image_read;
 
-  /// The painted target outside the region: segments per control edge (1..1024).
-  int resolution = 8;
+  /// The painted target outside the region: segments per control edge (1..1024); 0: about
+  /// kAutoTargetTriangles triangles for the whole target, at most 8 per edge
+  /// (auto_target_resolution in painted_surface.h).
+  int resolution = 0;
   /// Refine the region until every target edge is at most this long (0: off).
   double max_edge = 0.0;
   /// Refine the region to about one source texel of an N x N texture (0: off): source edges of at
