@@ -112,6 +112,67 @@ TEST(SpringEnergy, BarrierGradientMatchesFiniteDifferences) {
   EXPECT_GE(tested, 2);
 }
 
+// With normals the barrier sees each triangle's area along its apex normal: on a plane with the
+// plane's normal it is the 3D barrier exactly; off the plane (normals tilted, heights random) its
+// gradient, normals held fixed, matches central differences; a triangle that stands up from the
+// surface (its plane containing the normal) has a finite 3D barrier but is infinite as seen.
+TEST(SpringEnergy, BarrierSeenAlongTheNormals) {
+  const ParticleGrid grid = test::make_quad_grid(4, 3, 1.0);
+  const SpringEnergyOptions options{.stiffness = 1.0,
+                                    .angular_stiffness = 0.0,
+                                    .rest_scale = 1.2,
+                                    .barrier_stiffness = 0.7,
+                                    .barrier_sigma = 0.6};
+  const SpringSystem system(grid, options);
+  const SpringSystem springs_only(grid,
+                                  {.stiffness = 1.0, .angular_stiffness = 0.0, .rest_scale = 1.2});
+  int tested = 0;
+  for (unsigned seed = 1; seed <= 8; ++seed) {
+    Eigen::Matrix3Xd x = random_configuration(grid, 0.3, seed);
+    x.row(2).setZero();
+    Eigen::Matrix3Xd up = Eigen::Matrix3Xd::Zero(3, x.cols());
+    up.row(2).setOnes();
+    const double planar = system.evaluate(x).barrier;
+    if (!std::isfinite(planar) || !(planar > 0.0)) {
+      continue;
+    }
+    EXPECT_NEAR(system.evaluate(x, nullptr, &up).barrier, planar, 1e-12 * planar);
+    // Off the plane: heights and tilted normals from the same seed.
+    std::mt19937 rng(seed + 100);
+    std::uniform_real_distribution<double> u(-0.15, 0.15);
+    Eigen::Matrix3Xd normals(3, x.cols());
+    for (Eigen::Index p = 0; p < x.cols(); ++p) {
+      x(2, p) = u(rng);
+      normals.col(p) = Eigen::Vector3d(u(rng), u(rng), 1.0).normalized();
+    }
+    Eigen::Matrix3Xd gradient, spring_gradient;
+    const SpringEnergies e = system.evaluate(x, &gradient, &normals);
+    if (!std::isfinite(e.barrier) || !(e.barrier > 0.0)) {
+      continue;
+    }
+    ++tested;
+    springs_only.evaluate(x, &spring_gradient);
+    const Eigen::Matrix3Xd fd = central_differences(x, 1e-6, [&](const Eigen::Matrix3Xd& y) {
+      return system.evaluate(y, nullptr, &normals).barrier;
+    });
+    const Eigen::Matrix3Xd barrier_gradient = gradient - spring_gradient;
+    EXPECT_LT((fd - barrier_gradient).norm(), 1e-5 * barrier_gradient.norm()) << "seed " << seed;
+  }
+  EXPECT_GE(tested, 2);
+
+  // Stand the grid up: rotate it about the x axis by 90 degrees, keep the normals +z. Every
+  // triangle's plane now contains its normal (folded as seen from the surface) while its 3D shape
+  // is the rest shape.
+  Eigen::Matrix3Xd x = test::grid_positions(grid);
+  Eigen::Matrix3Xd standing = x;
+  standing.row(1).setZero();
+  standing.row(2) = x.row(1);
+  Eigen::Matrix3Xd up = Eigen::Matrix3Xd::Zero(3, x.cols());
+  up.row(2).setOnes();
+  EXPECT_TRUE(std::isfinite(system.evaluate(standing).barrier));
+  EXPECT_TRUE(std::isinf(system.evaluate(standing, nullptr, &up).barrier));
+}
+
 // A uniform compression of the whole grid by c (every triangle's stretches are c, c): each barrier
 // triangle has g = 2 / c^2 (with sigma = 1), so E_bar = mu C sum w A (g / g0 - 1)^3 with
 // sum w A = the grid's area (both splits of each quad at weight 1/2) when g > g0, and 0 when not.

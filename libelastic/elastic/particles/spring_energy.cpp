@@ -245,7 +245,8 @@ int SpringSystem::set_barrier_mask(const Eigen::Matrix3Xd& x, const Eigen::Matri
   return left_out;
 }
 
-SpringEnergies SpringSystem::evaluate(const Eigen::Matrix3Xd& x, Eigen::Matrix3Xd* gradient) const {
+SpringEnergies SpringSystem::evaluate(const Eigen::Matrix3Xd& x, Eigen::Matrix3Xd* gradient,
+                                      const Eigen::Matrix3Xd* normals) const {
   if (x.cols() != num_particles_) {
     throw InvalidInputError("particle positions", "expected " + std::to_string(num_particles_) +
                                                       " columns, got " + std::to_string(x.cols()));
@@ -306,15 +307,23 @@ SpringEnergies SpringSystem::evaluate(const Eigen::Matrix3Xd& x, Eigen::Matrix3X
       },
       std::plus<double>());
 
-  // Injectivity barrier (header): mu C w A h(g), g = sigma^2 tr(B G) det(S^T S) / det(G) with
-  // G = T^T T the target Gram matrix. With q = sigma^2 det(S^T S):
-  //   dg/dG00 = q (b00 / D - a G11 / D^2), dg/dG11 = q (b11 / D - a G00 / D^2),
-  //   dg/dG01 = q (2 b01 / D + 2 a G01 / D^2)   (G01 counted once, it appears twice in G),
-  // with a = tr(B G), D = det(G); and G00 = T0.T0, G11 = T1.T1, G01 = T0.T1 give
-  //   dg/dT0 = 2 dg/dG00 T0 + dg/dG01 T1,   dg/dT1 = 2 dg/dG11 T1 + dg/dG01 T0.
-  // A collapsed target triangle (D = 0) has infinite energy: the line search backs off.
+  // Injectivity barrier (header): mu C w A h(g), g = sigma^2 tr(B G) det(S^T S) / D with
+  // G = T^T T the target Gram matrix and D = det(G) = |c|^2, c = T0 x T1 (Lagrange's identity;
+  // the cross product keeps a sliver's D accurate where G00 G11 - G01^2 would cancel to
+  // round-off), or with normals D = (c . n)^2, the area seen along the apex normal n (header).
+  // With q = sigma^2 det(S^T S), a = tr(B G) and m = c (or (c . n) n):
+  //   dg/dT = q (da/dT / D - a dD/dT / D^2),
+  //   da/dT0 = 2 (b00 T0 + b01 T1),   da/dT1 = 2 (b11 T1 + b01 T0),
+  //   dD/dT0 = 2 T1 x m,              dD/dT1 = 2 m x T0.
+  // A collapsed (or, with normals, inverted) target triangle has infinite energy: the line search
+  // backs off.
   const double mu = options_.barrier_stiffness * C;
   if (mu > 0.0 && !barrier_.empty()) {
+    if (normals != nullptr && normals->cols() != num_particles_) {
+      throw InvalidInputError("particle normals", "expected " + std::to_string(num_particles_) +
+                                                      " columns, got " +
+                                                      std::to_string(normals->cols()));
+    }
     const double g0 = 1.0 / (options_.barrier_sigma * options_.barrier_sigma);
     energies.barrier = tbb::parallel_deterministic_reduce(
         tbb::blocked_range<std::size_t>(0, barrier_.size(), kGrain), 0.0,
@@ -330,13 +339,24 @@ SpringEnergies SpringSystem::evaluate(const Eigen::Matrix3Xd& x, Eigen::Matrix3X
             }
             const Eigen::Vector3d t0 = x.col(b.next) - x.col(b.i);
             const Eigen::Vector3d t1 = x.col(b.prev) - x.col(b.i);
-            const double G00 = t0.dot(t0), G01 = t0.dot(t1), G11 = t1.dot(t1);
-            const double D = G00 * G11 - G01 * G01;
+            const Eigen::Vector3d c = t0.cross(t1);
+            Eigen::Vector3d m = c;
+            if (normals != nullptr) {
+              const Eigen::Vector3d n = normals->col(b.i);
+              const double seen = c.dot(n);
+              if (!(seen > 0.0)) {
+                sum += std::numeric_limits<double>::infinity();
+                continue;
+              }
+              m = seen * n;
+            }
+            const double D = m.squaredNorm();
             if (!(D > 0.0)) {
               sum += std::numeric_limits<double>::infinity();
               continue;
             }
-            const double a = b.b00 * G00 + 2.0 * b.b01 * G01 + b.b11 * G11;
+            const double a =
+                b.b00 * t0.squaredNorm() + 2.0 * b.b01 * t0.dot(t1) + b.b11 * t1.squaredNorm();
             const double q = sigma * sigma * b.source_det;
             const double g = q * a / D;
             if (!(g > g0)) {
@@ -345,13 +365,13 @@ SpringEnergies SpringSystem::evaluate(const Eigen::Matrix3Xd& x, Eigen::Matrix3X
             const double r = g / g0 - 1.0;
             sum += mu * b.weight * r * r * r;
             if (want_gradient) {
-              const double dh = mu * b.weight * 3.0 * r * r / g0;  // dE/dg
-              const double D2 = D * D;
-              const double d00 = dh * q * (b.b00 / D - a * G11 / D2);
-              const double d11 = dh * q * (b.b11 / D - a * G00 / D2);
-              const double d01 = dh * q * (2.0 * b.b01 / D + 2.0 * a * G01 / D2);
-              const Eigen::Vector3d f0 = 2.0 * d00 * t0 + d01 * t1;  // dE/dx_next
-              const Eigen::Vector3d f1 = 2.0 * d11 * t1 + d01 * t0;  // dE/dx_prev
+              const double dh = mu * b.weight * 3.0 * r * r / g0 * q;  // dE/dg times q
+              const double over_d = 1.0 / D, a_over_d2 = a / (D * D);
+              // dE/dx_next and dE/dx_prev
+              const Eigen::Vector3d f0 =
+                  dh * (2.0 * over_d * (b.b00 * t0 + b.b01 * t1) - 2.0 * a_over_d2 * t1.cross(m));
+              const Eigen::Vector3d f1 =
+                  dh * (2.0 * over_d * (b.b11 * t1 + b.b01 * t0) - 2.0 * a_over_d2 * m.cross(t0));
               barrier_force_.col(col) = -(f0 + f1);
               barrier_force_.col(col + 1) = f0;
               barrier_force_.col(col + 2) = f1;

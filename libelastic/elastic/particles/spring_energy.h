@@ -32,7 +32,9 @@
 ///   affine map divided by sigma (s1, s2 its singular values, as in metrics/map_metrics.h). In
 ///   Gram-matrix form, with S, T the 3 x 2 edge matrices of the source and target triangle:
 ///       g = sigma^2 tr((S^T S)^-1 T^T T) det(S^T S) / det(T^T T),
-///   smooth in the target positions, infinite as the target triangle collapses (det(T^T T) -> 0),
+///   smooth in the target positions, infinite as the target triangle collapses (det(T^T T) -> 0;
+///   given surface normals, evaluate() uses the signed area seen along the apex normal instead,
+///   infinite as the triangle folds in folded_corners()' sense),
 ///   and zero unless the smaller stretch falls to about 1/sqrt(g0) = barrier_sigma (g0 =
 ///   barrier_sigma^-2): it leaves every triangle that is not close to collapse alone, so the
 ///   paper's minimum is unchanged wherever it is not degenerate. It is the barrier of Smith and
@@ -121,8 +123,14 @@ class SpringSystem {
   const SpringEnergyOptions& options() const { return options_; }
 
   /// Energies at positions `x` (3 x #P); when `gradient` is given it receives dE/dx (3 x #P,
-  /// resized).
-  SpringEnergies evaluate(const Eigen::Matrix3Xd& x, Eigen::Matrix3Xd* gradient = nullptr) const;
+  /// resized). With `normals` (3 x #P unit surface normals at the particles) the barrier measures
+  /// each triangle's area as seen along the normal n_i at its apex, signed: det(T^T T) becomes
+  /// ((T0 x T1) . n_i)^2 and a triangle with (T0 x T1) . n_i <= 0 has infinite energy, so that the
+  /// barrier guards exactly what folded_corners() tests (a thin triangle standing up from the
+  /// surface has a fine 3D area but is folded as seen from it). The gradient holds the normals
+  /// fixed (the solvers' steps are tangential). Without normals: the unsigned 3D area.
+  SpringEnergies evaluate(const Eigen::Matrix3Xd& x, Eigen::Matrix3Xd* gradient = nullptr,
+                          const Eigen::Matrix3Xd* normals = nullptr) const;
 
   /// Number of grid faces with at least one folded corner at positions `x`, given unit surface
   /// normals `normals` (3 x #P) at the particles. A corner (prev, i, next) of a counter-clockwise

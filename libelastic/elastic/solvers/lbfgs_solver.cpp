@@ -149,7 +149,7 @@ RelaxationResult relax_lbfgs(const RelaxationProblem& problem, const RelaxationO
 
   Eigen::Matrix3Xd gradient;
   resize_huge(gradient, 3, setup.num_particles);
-  SpringEnergies energies = setup.springs.evaluate(setup.positions, &gradient);
+  SpringEnergies energies = setup.springs.evaluate(setup.positions, &gradient, &setup.normals);
   result.initial_energy = energies.total();
   result.evaluations = 1;
   result.initial_folded_faces = setup.springs.folded_faces(setup.positions, setup.normals);
@@ -506,7 +506,11 @@ RelaxationResult relax_lbfgs(const RelaxationProblem& problem, const RelaxationO
         }
         continue;
       }
-      trial_energies = setup.springs.evaluate(trial_positions, &trial_gradient);
+      // The barrier sees each triangle along its apex normal (SpringSystem::evaluate): the current
+      // iterate's normals, held fixed through the line search, so that every trial and the slope
+      // belong to one function of the positions (with the trials' own normals, whose turning the
+      // gradient does not see, thin triangles made the Armijo test fail near the minimum).
+      trial_energies = setup.springs.evaluate(trial_positions, &trial_gradient, &setup.normals);
       ++result.evaluations;
       const double energy = energies.total();
       const double trial_energy = trial_energies.total();
@@ -581,6 +585,13 @@ RelaxationResult relax_lbfgs(const RelaxationProblem& problem, const RelaxationO
                   ? stalled + 1
                   : 0;
     energies = trial_energies;
+    if (energies.barrier > 0.0) {
+      // At the accepted point the barrier is taken again with its own normals (nothing changes
+      // where no triangle is near collapse: the barrier is zero there).
+      energies = setup.springs.evaluate(setup.positions, &gradient, &setup.normals);
+      ++result.evaluations;
+      layout.tangential(gradient, setup.normals, setup.curve_tangent, trial_q);
+    }
     q.swap(trial_q);
     q_norm = std::sqrt(dot(q, q));
     emit_frame(iteration + 1);

@@ -157,6 +157,28 @@ RelaxationResult relax_fast_paper(const RelaxationProblem& problem,
   return fast;
 }
 
+// The robust energy again from `from`'s fold-free end (every triangle in the barrier now: none
+// is folded), judged against the first run's start; the first run's counts are added.
+RelaxationResult restart_with_full_barrier(const RelaxationProblem& problem,
+                                           const RelaxationOptions& options,
+                                           const RelaxationResult& first,
+                                           const RelaxationResult& from) {
+  RelaxationProblem again = problem;
+  again.initial_positions = from.positions;
+  again.initial_points = from.points;
+  again.boundary_parameters = from.boundary_parameters;
+  again.reference_gradient_norm = first.initial_gradient_norm;
+  RelaxationResult result = relax_lbfgs(again, options);
+  result.initial_energy = first.initial_energy;
+  result.initial_folded_faces = first.initial_folded_faces;
+  result.initial_gradient_norm = first.initial_gradient_norm;
+  result.iterations += first.iterations;
+  result.evaluations += first.evaluations;
+  result.setup_seconds += first.setup_seconds;
+  result.solve_seconds += first.solve_seconds;
+  return result;
+}
+
 // Fast mode with the robust energy. The barrier keeps every triangle that starts unfolded away
 // from collapse, but it cannot be crossed, so a start with folded faces (the naive map folds a few
 // under extreme compression) is first untangled with the paper's energy (relax_fast_paper), and
@@ -167,8 +189,18 @@ RelaxationResult relax_fast_energy(const RelaxationProblem& problem,
     return relax_fast_paper(problem, options);
   }
   RelaxationResult robust = relax_lbfgs(problem, options);
-  if (robust.folded_faces == 0 || robust.reason == StopReason::Cancelled) {
+  if (robust.reason == StopReason::Cancelled) {
     return robust;
+  }
+  if (robust.folded_faces == 0) {
+    if (robust.converged || robust.initial_folded_faces == 0) {
+      return robust;
+    }
+    // The start's folded triangles were left out of the barrier and have unfolded since, but
+    // unprotected: one can stop at the fold guard's edge (a corner of orientation ~1e-18 that
+    // every step, however short, would fold again), where no line search finds a decrease. From
+    // this fold-free state every triangle joins the barrier, which pushes such a sliver open.
+    return restart_with_full_barrier(problem, options, robust, robust);
   }
   RelaxationOptions paper_options = options;
   paper_options.angular_stiffness = angular_stiffness(options);  // untangle with the same springs
@@ -180,19 +212,11 @@ RelaxationResult relax_fast_energy(const RelaxationProblem& problem,
     robust.untangle_steps = paper.untangle_steps;
     return robust;  // nothing fold-free to start the barrier from
   }
-  RelaxationProblem again = problem;
-  again.initial_positions = paper.positions;
-  again.initial_points = paper.points;
-  again.boundary_parameters = paper.boundary_parameters;
-  again.reference_gradient_norm = robust.initial_gradient_norm;
-  RelaxationResult result = relax_lbfgs(again, options);
-  result.initial_energy = robust.initial_energy;
-  result.initial_folded_faces = robust.initial_folded_faces;
-  result.initial_gradient_norm = robust.initial_gradient_norm;
-  result.iterations += robust.iterations + paper.iterations;
-  result.evaluations += robust.evaluations + paper.evaluations;
-  result.setup_seconds += robust.setup_seconds + paper.setup_seconds;
-  result.solve_seconds += robust.solve_seconds + paper.solve_seconds;
+  RelaxationResult result = restart_with_full_barrier(problem, options, robust, paper);
+  result.iterations += paper.iterations;
+  result.evaluations += paper.evaluations;
+  result.setup_seconds += paper.setup_seconds;
+  result.solve_seconds += paper.solve_seconds;
   result.untangle_steps = paper.untangle_steps;
   result.untangled = paper.untangled;
   result.untangle_phases = 1;

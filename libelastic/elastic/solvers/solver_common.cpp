@@ -233,7 +233,8 @@ double spring_gradient_norm(const RelaxationSetup& setup) {
 void finish_result(const RelaxationSetup& setup, const RelaxationProblem& problem,
                    double initial_gradient_norm, RelaxationResult& result) {
   Eigen::Matrix3Xd gradient;
-  const SpringEnergies energies = setup.springs.evaluate(setup.positions, &gradient);
+  const SpringEnergies energies =
+      setup.springs.evaluate(setup.positions, &gradient, &setup.normals);
   result.positions = setup.positions;
   result.points = setup.points;
   result.length_energy = energies.length;
