@@ -76,18 +76,22 @@ TEST(SpringEnergy, AngularGradientMatchesFiniteDifferences) {
   }
 }
 
+// The barrier tests' energy: unit length springs at rest scale 1.2, no angular springs, and (with
+// the barrier) mu 0.7 acting below a smaller stretch of 0.6; without it, the same springs alone.
+SpringEnergyOptions barrier_test_options(bool with_barrier) {
+  return {.stiffness = 1.0,
+          .angular_stiffness = 0.0,
+          .rest_scale = 1.2,
+          .barrier_stiffness = with_barrier ? 0.7 : 0.0,
+          .barrier_sigma = 0.6};
+}
+
 // The injectivity barrier: configurations compressed enough that many triangles are below the
 // threshold (amplitude 0.45 of the spacing), with springs off so the barrier is tested alone.
 TEST(SpringEnergy, BarrierGradientMatchesFiniteDifferences) {
   const ParticleGrid grid = test::make_quad_grid(4, 3, 1.0);
-  const SpringEnergyOptions options{.stiffness = 1.0,
-                                    .angular_stiffness = 0.0,
-                                    .rest_scale = 1.2,
-                                    .barrier_stiffness = 0.7,
-                                    .barrier_sigma = 0.6};
-  SpringSystem system(grid, options);
-  const SpringSystem springs_only(grid,
-                                  {.stiffness = 1.0, .angular_stiffness = 0.0, .rest_scale = 1.2});
+  SpringSystem system(grid, barrier_test_options(true));
+  const SpringSystem springs_only(grid, barrier_test_options(false));
   int tested = 0;
   for (unsigned seed = 1; seed <= 8; ++seed) {
     Eigen::Matrix3Xd x = random_configuration(grid, 0.3, seed);
@@ -118,14 +122,8 @@ TEST(SpringEnergy, BarrierGradientMatchesFiniteDifferences) {
 // surface (its plane containing the normal) has a finite 3D barrier but is infinite as seen.
 TEST(SpringEnergy, BarrierSeenAlongTheNormals) {
   const ParticleGrid grid = test::make_quad_grid(4, 3, 1.0);
-  const SpringEnergyOptions options{.stiffness = 1.0,
-                                    .angular_stiffness = 0.0,
-                                    .rest_scale = 1.2,
-                                    .barrier_stiffness = 0.7,
-                                    .barrier_sigma = 0.6};
-  const SpringSystem system(grid, options);
-  const SpringSystem springs_only(grid,
-                                  {.stiffness = 1.0, .angular_stiffness = 0.0, .rest_scale = 1.2});
+  const SpringSystem system(grid, barrier_test_options(true));
+  const SpringSystem springs_only(grid, barrier_test_options(false));
   int tested = 0;
   for (unsigned seed = 1; seed <= 8; ++seed) {
     Eigen::Matrix3Xd x = random_configuration(grid, 0.3, seed);

@@ -157,6 +157,15 @@ RelaxationResult relax_fast_paper(const RelaxationProblem& problem,
   return fast;
 }
 
+// Adds `from`'s work (iterations, evaluations, seconds) to `to`: one relaxation reports the work of
+// all its phases.
+void add_work(RelaxationResult& to, const RelaxationResult& from) {
+  to.iterations += from.iterations;
+  to.evaluations += from.evaluations;
+  to.setup_seconds += from.setup_seconds;
+  to.solve_seconds += from.solve_seconds;
+}
+
 // The robust energy again from `from`'s fold-free end (every triangle in the barrier now: none
 // is folded), judged against the first run's start; the first run's counts are added.
 RelaxationResult restart_with_full_barrier(const RelaxationProblem& problem,
@@ -172,10 +181,7 @@ RelaxationResult restart_with_full_barrier(const RelaxationProblem& problem,
   result.initial_energy = first.initial_energy;
   result.initial_folded_faces = first.initial_folded_faces;
   result.initial_gradient_norm = first.initial_gradient_norm;
-  result.iterations += first.iterations;
-  result.evaluations += first.evaluations;
-  result.setup_seconds += first.setup_seconds;
-  result.solve_seconds += first.solve_seconds;
+  add_work(result, first);
   return result;
 }
 
@@ -213,10 +219,7 @@ RelaxationResult relax_fast_energy(const RelaxationProblem& problem,
     return robust;  // nothing fold-free to start the barrier from
   }
   RelaxationResult result = restart_with_full_barrier(problem, options, robust, paper);
-  result.iterations += paper.iterations;
-  result.evaluations += paper.evaluations;
-  result.setup_seconds += paper.setup_seconds;
-  result.solve_seconds += paper.solve_seconds;
+  add_work(result, paper);
   result.untangle_steps = paper.untangle_steps;
   result.untangled = paper.untangled;
   result.untangle_phases = 1;
@@ -265,10 +268,8 @@ RelaxationResult relax_fast(const RelaxationProblem& problem, const RelaxationOp
     if (plain.converged && plain.folded_faces == 0) {
       plain.slide_iterations = slid.iterations;
       plain.slide_reason = slid.reason;
-      plain.iterations += slid.iterations + result.iterations;
-      plain.evaluations += slid.evaluations + result.evaluations;
-      plain.setup_seconds += slid.setup_seconds + result.setup_seconds;
-      plain.solve_seconds += slid.solve_seconds + result.solve_seconds;
+      add_work(plain, slid);
+      add_work(plain, result);
       return plain;  // boundary = Fixed: the report says the slide was not kept
     }
   }
@@ -278,10 +279,7 @@ RelaxationResult relax_fast(const RelaxationProblem& problem, const RelaxationOp
   result.slide_reason = slid.reason;
   result.initial_energy = slid.initial_energy;
   result.initial_folded_faces = slid.initial_folded_faces;
-  result.iterations += slid.iterations;
-  result.evaluations += slid.evaluations;
-  result.setup_seconds += slid.setup_seconds;
-  result.solve_seconds += slid.solve_seconds;
+  add_work(result, slid);
   result.untangle_phases += slid.untangle_phases;
   result.untangle_steps += slid.untangle_steps;
   return result;
