@@ -184,9 +184,9 @@ PasteOptions paste_options(const PasteArgs& a, const PolygonMesh* detail) {
 }
 
 // The map job of a paste: the painted mesh's memory is checked with the map's before the map
-// runs: the target tessellated at --resolution (resolution^2 vertices per control face), and the
-// region refined to --min-vertices (to --max-vertices when --max-edge or --texture-resolution
-// drive it).
+// runs: the target tessellated at --target-tessellation N (N^2 vertices per control face; auto:
+// the budget of auto_target_resolution, painted_surface.h), and the region refined to
+// --min-vertices (to --max-vertices when --max-edge or --texture-resolution drive it).
 MapJob paste_map_job(const PasteArgs& a) {
   MapJob job = a.job;
   const bool refined_by_edges = a.max_edge > 0.0 || a.texture_resolution > 0;
