@@ -241,6 +241,8 @@ RelaxationResult relax_fast(const RelaxationProblem& problem, const RelaxationOp
   sliding.max_iterations = options.max_iterations > 0
                                ? std::min(options.max_iterations, kSlideIterations)
                                : kSlideIterations;
+  sliding.relative_gradient_tolerance =
+      std::max(options.relative_gradient_tolerance, options.slide_tolerance);
   RelaxationResult slid = relax_fast_energy(problem, sliding);  // not const: returned by move
   if (slid.reason == StopReason::Cancelled || slid.positions.cols() == 0) {
     return slid;

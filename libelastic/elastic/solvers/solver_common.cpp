@@ -64,7 +64,7 @@ RelaxationSetup::RelaxationSetup(const RelaxationProblem& problem, const Relaxat
     throw InvalidInputError(kName, "boundary targets do not have one entry per boundary particle");
   }
   if (!(options.relative_gradient_tolerance >= 0.0) ||
-      !(options.absolute_gradient_tolerance >= 0.0)) {
+      !(options.absolute_gradient_tolerance >= 0.0) || !(options.slide_tolerance >= 0.0)) {
     throw InvalidInputError(kName, "gradient tolerances must be non-negative");
   }
   if (options.max_iterations < 0 || options.frame_interval < 1 || options.threads < 0) {
