@@ -1,5 +1,8 @@
 #include "elastic/mapping/initial_map.h"
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -222,41 +225,72 @@ void RegionDiskMap::set_offset(double offset) {
   turn_ << std::cos(angle), -std::sin(angle), std::sin(angle), std::cos(angle);
 }
 
-InitialMap naive_map(const ParticleGrid& grid, const RegionDiskMap& source,
-                     const RegionDiskMap& target) {
+namespace {
+
+// The half of the naive map that does not depend on the target: each interior particle's point on
+// the source's disk, each boundary particle's correspondence parameter (-1 for interior ones).
+struct SourceDiskPoints {
+  std::vector<Eigen::Vector2d> disk;
+  std::vector<double> parameter;
+  std::vector<char> outside;  // 1: the source point is not in the source region (disk = 0)
+};
+
+SourceDiskPoints source_disk_points(const ParticleGrid& grid, const RegionDiskMap& source) {
   const int n = grid.num_particles();
-  InitialMap result;
-  result.positions.resize(3, n);
-  result.points.resize(n);
-  const LimitSurface& surface = *target.region().surface;
-  std::vector<double> parameter(n, -1.0);
-  for (size_t k = 0; k < grid.boundary_loop.size(); ++k) {
-    parameter[grid.boundary_loop[k]] = grid.boundary_parameter[k];
+  SourceDiskPoints result;
+  result.disk.assign(static_cast<std::size_t>(n), Eigen::Vector2d::Zero());
+  result.parameter.assign(static_cast<std::size_t>(n), -1.0);
+  result.outside.assign(static_cast<std::size_t>(n), 0);
+  for (std::size_t k = 0; k < grid.boundary_loop.size(); ++k) {
+    result.parameter[static_cast<std::size_t>(grid.boundary_loop[k])] = grid.boundary_parameter[k];
   }
-  for (int i = 0; i < n; ++i) {
-    SurfacePoint q;
-    if (parameter[i] >= 0.0) {
-      q = target.boundary_point(parameter[i]);
-    } else {
-      Eigen::Vector2d disk;
-      if (!source.to_disk(grid.source_points[i], disk)) {
-        ++result.outside;
-        disk.setZero();  // keep the particle inside the target region; counted as outside
-      }
-      if (!target.from_disk(disk, q)) {
-        ++result.outside;
-        target.from_disk(Eigen::Vector2d::Zero(), q);
+  // Each particle on its own (the disk maps are immutable): the same result on any thread count.
+  tbb::parallel_for(tbb::blocked_range<int>(0, n, 512), [&](const tbb::blocked_range<int>& r) {
+    for (int i = r.begin(); i != r.end(); ++i) {
+      const auto k = static_cast<std::size_t>(i);
+      if (result.parameter[k] < 0.0 && !source.to_disk(grid.source_points[k], result.disk[k])) {
+        result.outside[k] = 1;
+        result.disk[k].setZero();  // keep the particle inside the target region; counted outside
       }
     }
-    result.points[i] = q;
-    result.positions.col(i) = surface.position(q);
+  });
+  return result;
+}
+
+// The other half: the disk points onto the target region.
+InitialMap place_on_target(const SourceDiskPoints& from, const RegionDiskMap& target) {
+  const auto n = static_cast<int>(from.disk.size());
+  InitialMap result;
+  result.positions.resize(3, n);
+  result.points.resize(static_cast<std::size_t>(n));
+  const LimitSurface& surface = *target.region().surface;
+  std::vector<char> missed(static_cast<std::size_t>(n), 0);
+  tbb::parallel_for(tbb::blocked_range<int>(0, n, 512), [&](const tbb::blocked_range<int>& r) {
+    for (int i = r.begin(); i != r.end(); ++i) {
+      const auto k = static_cast<std::size_t>(i);
+      SurfacePoint q;
+      if (from.parameter[k] >= 0.0) {
+        q = target.boundary_point(from.parameter[k]);
+      } else if (!target.from_disk(from.disk[k], q)) {
+        missed[k] = 1;
+        target.from_disk(Eigen::Vector2d::Zero(), q);
+      }
+      result.points[k] = q;
+      result.positions.col(i) = surface.position(q);
+    }
+  });
+  for (std::size_t k = 0; k < missed.size(); ++k) {
+    result.outside += from.outside[k] + missed[k];
   }
   return result;
 }
 
-}  // namespace elastic
+}  // namespace
 
-namespace elastic {
+InitialMap naive_map(const ParticleGrid& grid, const RegionDiskMap& source,
+                     const RegionDiskMap& target) {
+  return place_on_target(source_disk_points(grid, source), target);
+}
 
 BoundaryOffsetResult choose_boundary_offset(const ParticleGrid& grid, const RegionDiskMap& source,
                                             RegionDiskMap& target,
@@ -268,10 +302,12 @@ BoundaryOffsetResult choose_boundary_offset(const ParticleGrid& grid, const Regi
   BoundaryOffsetResult result;
   result.candidates = options.candidates;
   double best = std::numeric_limits<double>::infinity();
+  // The source half of the naive map does not turn with the offset: computed once.
+  const SourceDiskPoints from = source_disk_points(grid, source);
   for (int k = 0; k < options.candidates; ++k) {
     const double offset = static_cast<double>(k) / options.candidates;
     target.set_offset(offset);
-    const InitialMap naive = naive_map(grid, source, target);
+    const InitialMap naive = place_on_target(from, target);
     const double energy = naive.outside > 0 ? std::numeric_limits<double>::infinity()
                                             : springs.evaluate(naive.positions).total();
     if (k == 0) {
