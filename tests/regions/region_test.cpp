@@ -12,6 +12,7 @@
 #include "elastic/core/error.h"
 #include "elastic/mesh/mesh_io.h"
 #include "elastic/projection/closest_point.h"
+#include "elastic/regions/heat_geodesics.h"
 #include "elastic/regions/region_spec.h"
 #include "elastic/regions/texture_coordinates.h"
 #include "elastic/shapes/procedural_shapes.h"
@@ -164,6 +165,65 @@ TEST(DiskRegion, SphereBoundaryIsAGeodesicCircleOrientedCounterClockwise) {
   EXPECT_GT(projected_winding_area(region, centre.position, centre.normal), 0.0);
   // The bigger side (the rest of the sphere) is not what we get: the disk is the geodesic disk.
   EXPECT_LT(region.area(), 0.5 * 4.0 * kPi * rho * rho);
+}
+
+// A flat grid mesh of (n + 1)^2 vertices on [-half, half]^2 at height z, appended to `positions`
+// and `triangles` (two triangles per cell, counter-clockwise seen from +z).
+void append_grid(int n, double half, double z, std::vector<Eigen::Vector3d>& positions,
+                 std::vector<Eigen::Vector3i>& triangles) {
+  const int base = static_cast<int>(positions.size());
+  for (int i = 0; i <= n; ++i) {
+    for (int j = 0; j <= n; ++j) {
+      positions.emplace_back(-half + 2.0 * half * j / n, -half + 2.0 * half * i / n, z);
+    }
+  }
+  const auto v = [&](int i, int j) { return base + i * (n + 1) + j; };
+  for (int i = 0; i < n; ++i) {
+    for (int j = 0; j < n; ++j) {
+      triangles.emplace_back(v(i, j), v(i, j + 1), v(i + 1, j + 1));
+      triangles.emplace_back(v(i, j), v(i + 1, j + 1), v(i + 1, j));
+    }
+  }
+}
+
+// The disk's local heat distance: on a plane the geodesic distance is the Euclidean one, so within
+// the reach it must match |x - c| to the heat method's error (a few edges near the source, O(h)
+// beyond); vertices farther than twice the reach, and a second sheet 0.05 above the plane (inside
+// the Euclidean ball but not connected to the source), get `far`; a reach that covers the mesh
+// falls back to the whole mesh, bit for bit.
+TEST(LocalGeodesics, PlaneDistanceWithinReachAndFarBeyond) {
+  std::vector<Eigen::Vector3d> x;
+  std::vector<Eigen::Vector3i> tri;
+  const int n = 80;
+  const double half = 1.0, h = 2.0 * half / n, reach = 0.3, far = 10.0;
+  append_grid(n, half, 0.0, x, tri);
+  const int sheet = static_cast<int>(x.size());
+  append_grid(8, 0.2, 0.05, x, tri);
+  // The source at the plane's centre vertex (row 40, column 40): corner 0 of that cell's triangle.
+  const regions_detail::MeshLocation source{2 * (40 * n + 40), Eigen::Vector3d(1.0, 0.0, 0.0)};
+  ASSERT_LT(x[static_cast<size_t>(tri[static_cast<size_t>(source.triangle)][0])].norm(), 1e-12);
+  const Eigen::VectorXd d =
+      regions_detail::local_geodesic_distance(x, tri, source, reach, far, "plane");
+  int within = 0, beyond = 0;
+  for (int v = 0; v < sheet; ++v) {
+    const double r = x[static_cast<size_t>(v)].norm();
+    if (r <= reach) {
+      EXPECT_NEAR(d[v], r, 2.0 * h) << v;
+      ++within;
+    } else if (r > 2.0 * reach + 2.0 * h) {
+      EXPECT_EQ(d[v], far) << v;
+      ++beyond;
+    }
+  }
+  EXPECT_GT(within, 400);
+  EXPECT_GT(beyond, 4000);
+  for (int v = sheet; v < static_cast<int>(x.size()); ++v) {
+    EXPECT_EQ(d[v], far) << "vertex " << v << " of the unconnected sheet";
+  }
+  const Eigen::VectorXd whole =
+      regions_detail::local_geodesic_distance(x, tri, source, 5.0, far, "plane");
+  const Eigen::VectorXd reference = regions_detail::HeatGeodesics(x, tri, "plane").distance(source);
+  EXPECT_EQ((whole - reference).cwiseAbs().maxCoeff(), 0.0);
 }
 
 TEST(BoundaryRegion, CapIsTheWholeCapCounterClockwiseAboutItsNormal) {

@@ -189,4 +189,95 @@ Eigen::VectorXd HeatGeodesics::distance(const MeshLocation& source) const {
   return phi;
 }
 
+Eigen::VectorXd local_geodesic_distance(const std::vector<Eigen::Vector3d>& positions,
+                                        const std::vector<Eigen::Vector3i>& triangles,
+                                        const MeshLocation& source, double reach, double far,
+                                        const std::string& name) {
+  const auto nt = triangles.size();
+  const auto nv = positions.size();
+  const Eigen::Vector3i& home = triangles[static_cast<size_t>(source.triangle)];
+  const Eigen::Vector3d centre = source.bary[0] * positions[static_cast<size_t>(home[0])] +
+                                 source.bary[1] * positions[static_cast<size_t>(home[1])] +
+                                 source.bary[2] * positions[static_cast<size_t>(home[2])];
+  // Triangles near the source, then the ones connected to the source's triangle through shared
+  // corners (breadth first over vertex -> triangle incidences of the near ones).
+  const double ball = 2.0 * reach;
+  std::vector<char> near(nv, 0), selected(nt, 0);
+  for (size_t v = 0; v < nv; ++v) {
+    near[v] = (positions[v] - centre).squaredNorm() <= ball * ball;
+  }
+  std::vector<int> start(nv + 1, 0);
+  for (size_t t = 0; t < nt; ++t) {
+    const Eigen::Vector3i& tri = triangles[t];
+    if (near[static_cast<size_t>(tri[0])] || near[static_cast<size_t>(tri[1])] ||
+        near[static_cast<size_t>(tri[2])] || static_cast<int>(t) == source.triangle) {
+      selected[t] = 1;
+      for (int k = 0; k < 3; ++k) {
+        ++start[static_cast<size_t>(tri[k]) + 1];
+      }
+    }
+  }
+  for (size_t v = 0; v < nv; ++v) {
+    start[v + 1] += start[v];
+  }
+  std::vector<int> incident(static_cast<size_t>(start[nv]));
+  std::vector<int> fill(start.begin(), start.end() - 1);
+  for (size_t t = 0; t < nt; ++t) {
+    if (selected[t]) {
+      for (int k = 0; k < 3; ++k) {
+        incident[static_cast<size_t>(fill[static_cast<size_t>(triangles[t][k])]++)] =
+            static_cast<int>(t);
+      }
+    }
+  }
+  std::vector<char> reached(nt, 0);
+  std::vector<int> queue{source.triangle};
+  reached[static_cast<size_t>(source.triangle)] = 1;
+  for (size_t q = 0; q < queue.size(); ++q) {
+    for (int k = 0; k < 3; ++k) {
+      const auto v = static_cast<size_t>(triangles[static_cast<size_t>(queue[q])][k]);
+      for (int i = start[v]; i < start[v + 1]; ++i) {
+        const auto t = static_cast<size_t>(incident[static_cast<size_t>(i)]);
+        if (!reached[t]) {
+          reached[t] = 1;
+          queue.push_back(static_cast<int>(t));
+        }
+      }
+    }
+  }
+  if (10 * queue.size() > 7 * nt) {
+    return HeatGeodesics(positions, triangles, name).distance(source);
+  }
+  // The part as a mesh of its own, in the whole mesh's triangle order.
+  std::sort(queue.begin(), queue.end());
+  std::vector<int> local(nv, -1), global;
+  std::vector<Eigen::Vector3d> part_positions;
+  std::vector<Eigen::Vector3i> part_triangles;
+  part_triangles.reserve(queue.size());
+  MeshLocation part_source = source;
+  for (const int t : queue) {
+    Eigen::Vector3i tri;
+    for (int k = 0; k < 3; ++k) {
+      const auto v = static_cast<size_t>(triangles[static_cast<size_t>(t)][k]);
+      if (local[v] < 0) {
+        local[v] = static_cast<int>(global.size());
+        global.push_back(static_cast<int>(v));
+        part_positions.push_back(positions[v]);
+      }
+      tri[k] = local[v];
+    }
+    if (t == source.triangle) {
+      part_source.triangle = static_cast<int>(part_triangles.size());
+    }
+    part_triangles.push_back(tri);
+  }
+  const Eigen::VectorXd part =
+      HeatGeodesics(part_positions, part_triangles, name).distance(part_source);
+  Eigen::VectorXd distance = Eigen::VectorXd::Constant(static_cast<Eigen::Index>(nv), far);
+  for (size_t i = 0; i < global.size(); ++i) {
+    distance[global[i]] = part[static_cast<Eigen::Index>(i)];
+  }
+  return distance;
+}
+
 }  // namespace elastic::regions_detail

@@ -160,8 +160,9 @@ Region disk_region(const Context& ctx, const RegionSpec& spec) {
         text << "disk:" << q.x() << ',' << q.y() << ',' << q.z() << ',' << spec.radius;
         return text.str();
       });
-  const regions_detail::HeatGeodesics heat(ctx.tess.positions, ctx.tess.triangles, name);
-  const Eigen::VectorXd distance = heat.distance(centre);
+  // Vertices beyond the disk's reach get a distance of 4 R: outside, far from the level set.
+  const Eigen::VectorXd distance = regions_detail::local_geodesic_distance(
+      ctx.tess.positions, ctx.tess.triangles, centre, spec.radius, 4.0 * spec.radius, name);
   CutMesh cut = ctx.cut_mesh();
   // Level set phi = distance - R, cut exactly: every edge whose ends have opposite signs is split
   // where the linear interpolant vanishes. Crossings within kSnap of an end move to that end (phi
@@ -246,9 +247,16 @@ Region disk_region(const Context& ctx, const RegionSpec& spec) {
     }
   }
   if (chosen < 0) {
+    const Eigen::Vector3i& home = ctx.tess.triangles[static_cast<size_t>(centre.triangle)];
+    double edge_sum = 0.0;
+    for (int k = 0; k < 3; ++k) {
+      edge_sum += (ctx.tess.positions[static_cast<size_t>(home[(k + 1) % 3])] -
+                   ctx.tess.positions[static_cast<size_t>(home[k])])
+                      .norm();
+    }
     throw InvalidInputError(name, "the disk of radius " + std::to_string(spec.radius) +
                                       " is too small for the surface's tessellation (edges about " +
-                                      std::to_string(heat.mean_edge_length()) + " long)");
+                                      std::to_string(edge_sum / 3.0) + " long at the centre)");
   }
   PatchTopology topo = regions_detail::patch_topology(cut, comps[static_cast<size_t>(chosen)]);
   if (topo.loops.empty()) {
