@@ -57,7 +57,9 @@ TEST(MapRegions, PlaneOntoRigidlyMovedCopyIsTheRigidMotion) {
 // anchors leaves a correspondence no relaxation with a fixed boundary can undo.
 TEST(MapRegions, ChosenOffsetUndoesATurnWithoutAnchors) {
   PolygonMesh plane = make_plane({.faces = ShapeFaces::Quads, .resolution = 12});
-  for (Eigen::Vector3d& p : plane.positions) p.x() *= 2.0;
+  for (Eigen::Vector3d& p : plane.positions) {
+    p.x() *= 2.0;
+  }
   const Eigen::Isometry3d turn(Eigen::AngleAxisd(0.5 * std::acos(-1.0), Eigen::Vector3d::UnitZ()));
   const LimitSurface source_surface(plane), target_surface(test::moved(plane, turn));
   const SurfaceProjector source(source_surface), target(target_surface);

@@ -52,8 +52,9 @@ TEST(SurfaceCurve, NearestArcParameter) {
   EXPECT_NEAR(c.nearest_arc_parameter({3, 1, 0}), 3.0 / 8.0, 1e-15);
   EXPECT_NEAR(c.nearest_arc_parameter({-1, 1.5, 5}), 6.5 / 8.0, 1e-15);
   // Round trip with locate.
-  for (double s : {0.05, 0.4, 0.77})
+  for (double s : {0.05, 0.4, 0.77}) {
     EXPECT_NEAR(c.nearest_arc_parameter(c.locate(s).position), s, 1e-12);
+  }
 }
 
 struct Surface {
@@ -92,7 +93,9 @@ TEST(RegionFlattening, DiskMapIsBijectiveWithBoundaryOnTheCircleByArcLength) {
   }
   // Interior vertices strictly inside the disk.
   std::vector<char> on_boundary(flat.uv.size(), 0);
-  for (int v : region.boundary) on_boundary[static_cast<size_t>(v)] = 1;
+  for (int v : region.boundary) {
+    on_boundary[static_cast<size_t>(v)] = 1;
+  }
   for (size_t v = 0; v < flat.uv.size(); ++v) {
     if (!on_boundary[v]) {
       EXPECT_LT(flat.uv[v].norm(), 1.0);

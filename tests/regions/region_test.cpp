@@ -59,8 +59,9 @@ PolygonMesh plane_mesh() {
 /// The plane with texture coordinates (x+1)/2, (y+1)/2 at every corner.
 PolygonMesh textured_plane() {
   PolygonMesh mesh = plane_mesh();
-  for (const Eigen::Vector3d& x : mesh.positions)
+  for (const Eigen::Vector3d& x : mesh.positions) {
     mesh.texcoords.emplace_back(0.5 * (x.x() + 1.0), 0.5 * (x.y() + 1.0));
+  }
   mesh.corner_texcoords = mesh.face_vertices;
   return mesh;
 }
@@ -235,8 +236,9 @@ TEST(BoundaryRegion, CapIsTheWholeCapCounterClockwiseAboutItsNormal) {
   const LimitTessellation& tess = fx.projector->tessellation();
   EXPECT_EQ(region.num_triangles(), static_cast<int>(tess.triangles.size()));
   // Every boundary vertex is on the surface boundary.
-  for (int v : region.boundary)
+  for (int v : region.boundary) {
     EXPECT_TRUE(fx.surface->on_boundary(region.points[static_cast<size_t>(v)], 1e-9));
+  }
   // Seen from above (the cap's outward normal at the pole is +z), counter-clockwise.
   EXPECT_GT(projected_winding_area(region, Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitZ()), 0.0);
 }

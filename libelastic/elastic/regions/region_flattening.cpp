@@ -271,10 +271,11 @@ RegionFlattening flatten_conformal(const Region& region) {
       }
     }
   }
-  Eigen::SparseMatrix<double> full(2 * nv, 2 * nv);
+  const Eigen::Index unknowns = Eigen::Index{2} * nv;
+  Eigen::SparseMatrix<double> full(unknowns, unknowns);
   full.setFromTriplets(q.begin(), q.end());
-  std::vector<int> index(static_cast<size_t>(2 * nv), -1);
-  Eigen::VectorXd fixed = Eigen::VectorXd::Zero(2 * nv);
+  std::vector<int> index(static_cast<size_t>(unknowns), -1);
+  Eigen::VectorXd fixed = Eigen::VectorXd::Zero(unknowns);
   fixed[pin1] = pin_distance;  // pin0 at (0, 0), pin1 at (d, 0)
   int free = 0;
   for (int r = 0; r < 2 * nv; ++r) {

@@ -99,7 +99,9 @@ struct Context {
           << ") is far from the surface (" << cp.distance << " away, more than "
           << options.max_point_distance << " of the bounding-box diagonal); the nearest surface "
           << "point is (" << q.x() << ", " << q.y() << ", " << q.z() << ")";
-      if (suggest) msg << ": try " << suggest(q);
+      if (suggest) {
+        msg << ": try " << suggest(q);
+      }
       throw InvalidInputError(options.name, msg.str());
     }
     return locate(cp.point);
