@@ -216,7 +216,8 @@ RelaxationResult relax_fast_energy(const RelaxationProblem& problem,
   if (paper.folded_faces > 0) {
     robust.untangle_phases = 1;
     robust.untangle_steps = paper.untangle_steps;
-    return robust;  // nothing fold-free to start the barrier from
+    add_work(robust, paper);  // the failed untangling's time is the user's too
+    return robust;            // nothing fold-free to start the barrier from
   }
   RelaxationResult result = restart_with_full_barrier(problem, options, robust, paper);
   add_work(result, paper);
@@ -274,6 +275,7 @@ RelaxationResult relax_fast(const RelaxationProblem& problem, const RelaxationOp
       add_work(plain, result);
       return plain;  // boundary = Fixed: the report says the slide was not kept
     }
+    add_work(result, plain);  // tried and not kept: its time still counts
   }
   result.boundary = BoundaryMode::Slide;
   result.boundary_slide = slid.boundary_slide;
