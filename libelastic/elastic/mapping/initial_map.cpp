@@ -3,11 +3,13 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <map>
 #include <numbers>
+#include <numeric>
 
 #include "elastic/core/error.h"
 #include "elastic/core/triangle_locator_2d.h"
@@ -292,6 +294,28 @@ InitialMap naive_map(const ParticleGrid& grid, const RegionDiskMap& source,
   return place_on_target(source_disk_points(grid, source), target);
 }
 
+namespace {
+
+// Faces of the naive map that fold against the target surface's normals at the particles (the
+// solver's own fold test, SpringSystem::folded_faces).
+int naive_folds(const SpringSystem& springs, const InitialMap& naive, const LimitSurface& surface) {
+  const auto n = static_cast<Eigen::Index>(naive.points.size());
+  Eigen::Matrix3Xd normals(3, n);
+  tbb::parallel_for(
+      tbb::blocked_range<Eigen::Index>(0, n, 512), [&](const tbb::blocked_range<Eigen::Index>& r) {
+        for (Eigen::Index i = r.begin(); i != r.end(); ++i) {
+          const SurfaceDerivatives d =
+              surface.derivatives(naive.points[static_cast<std::size_t>(i)]);
+          const Eigen::Vector3d normal = d.du.cross(d.dv);
+          normals.col(i) =
+              normal.norm() > 0.0 ? Eigen::Vector3d(normal.normalized()) : Eigen::Vector3d::Zero();
+        }
+      });
+  return springs.folded_faces(naive.positions, normals);
+}
+
+}  // namespace
+
 BoundaryOffsetResult choose_boundary_offset(const ParticleGrid& grid, const RegionDiskMap& source,
                                             RegionDiskMap& target,
                                             const BoundaryOffsetOptions& options) {
@@ -301,24 +325,45 @@ BoundaryOffsetResult choose_boundary_offset(const ParticleGrid& grid, const Regi
   const SpringSystem springs(grid, options.energy);
   BoundaryOffsetResult result;
   result.candidates = options.candidates;
-  double best = std::numeric_limits<double>::infinity();
   // The source half of the naive map does not turn with the offset: computed once.
   const SourceDiskPoints from = source_disk_points(grid, source);
+  std::vector<double> energy(static_cast<std::size_t>(options.candidates));
   for (int k = 0; k < options.candidates; ++k) {
-    const double offset = static_cast<double>(k) / options.candidates;
-    target.set_offset(offset);
+    target.set_offset(static_cast<double>(k) / options.candidates);
     const InitialMap naive = place_on_target(from, target);
-    const double energy = naive.outside > 0 ? std::numeric_limits<double>::infinity()
-                                            : springs.evaluate(naive.positions).total();
-    if (k == 0) {
-      result.energy_at_zero = energy;
+    energy[static_cast<std::size_t>(k)] = naive.outside > 0
+                                              ? std::numeric_limits<double>::infinity()
+                                              : springs.evaluate(naive.positions).total();
+  }
+  result.energy_at_zero = energy[0];
+  // By energy (ties keep the smaller offset: the region's own anchor first); the first whose naive
+  // map folds no face wins, else the one with the fewest folds. A folded start is what the solver
+  // handles worst (the barrier cannot cross a fold; untangling can fail), and usually only the
+  // first candidate is tested.
+  std::vector<int> order(energy.size());
+  std::iota(order.begin(), order.end(), 0);
+  std::stable_sort(order.begin(), order.end(), [&](int a, int b) {
+    return energy[static_cast<std::size_t>(a)] < energy[static_cast<std::size_t>(b)];
+  });
+  const LimitSurface& surface = *target.region().surface;
+  int fewest = std::numeric_limits<int>::max();
+  for (const int k : order) {
+    if (!std::isfinite(energy[static_cast<std::size_t>(k)]) &&
+        fewest < std::numeric_limits<int>::max()) {
+      break;
     }
-    if (energy < best) {  // ties keep the smaller offset (the region's own anchor first)
-      best = energy;
-      result.offset = offset;
+    target.set_offset(static_cast<double>(k) / options.candidates);
+    const int folds = naive_folds(springs, place_on_target(from, target), surface);
+    if (folds < fewest) {
+      fewest = folds;
+      result.offset = static_cast<double>(k) / options.candidates;
+      result.energy = energy[static_cast<std::size_t>(k)];
+      result.folds = folds;
+    }
+    if (folds == 0) {
+      break;
     }
   }
-  result.energy = best;
   target.set_offset(result.offset);
   return result;
 }

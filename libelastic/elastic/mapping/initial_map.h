@@ -79,15 +79,16 @@ struct BoundaryOffsetResult {
   double offset = 0.0;          ///< the chosen offset, as set on the target disk map
   double energy = 0.0;          ///< E_len + E_ang of the naive map with that offset
   double energy_at_zero = 0.0;  ///< the same with the region's own anchor (offset 0)
+  int folds = 0;                ///< faces the chosen offset's naive map folds
   int candidates = 0;           ///< offsets tried
 };
 
 /// Chooses where the boundary correspondence starts on the target (when no anchor says so): the
-/// offset among `candidates` equally spaced ones whose naive map has the least paper energy, set on
-/// `target` (RegionDiskMap::set_offset). A rotation of the correspondence the user did not ask
-/// for costs nothing, and a bad one (a rectangle's corners landing where the target curve bends,
-/// a shape turned against the target's) forces distortion that no relaxation with a fixed boundary
-/// can remove.
+/// offset among `candidates` equally spaced ones whose naive map has the least paper energy among
+/// those that fold no face (else the fewest folds), set on `target` (RegionDiskMap::set_offset). A
+/// rotation of the correspondence the user did not ask for costs nothing, and a bad one (a
+/// rectangle's corners landing where the target curve bends, a shape turned against the target's)
+/// forces distortion that no relaxation with a fixed boundary can remove.
 BoundaryOffsetResult choose_boundary_offset(const ParticleGrid& grid, const RegionDiskMap& source,
                                             RegionDiskMap& target,
                                             const BoundaryOffsetOptions& options = {});

@@ -66,6 +66,7 @@ MapResult map_regions(const SurfaceProjector& source, const Region& source_regio
     result.offset_chosen = true;
     result.offset_energy = offset.energy;
     result.offset_energy_at_zero = offset.energy_at_zero;
+    result.offset_folds = offset.folds;
   }
   result.naive = naive_map(grid, *result.source_disk, *result.target_disk);
   if (result.naive.outside > 0) {

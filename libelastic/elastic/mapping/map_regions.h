@@ -68,6 +68,8 @@ struct MapResult {
   bool offset_chosen = false;  ///< whether choose_boundary_offset ran (no anchor given)
   /// The naive map's paper energy with the chosen offset and with offset 0 (when chosen).
   double offset_energy = 0.0, offset_energy_at_zero = 0.0;
+  /// Faces the chosen offset's naive map folds (0 unless every candidate folds).
+  int offset_folds = 0;
   double seconds_sampling = 0.0;  ///< source sampling (layout + adaptive sampling + springs)
   double seconds_naive = 0.0;     ///< disk maps of both regions + naive placement
   double seconds_mapping = 0.0;   ///< building the queryable mapping
