@@ -13,6 +13,7 @@
 
 #include "elastic/core/error.h"
 #include "elastic/core/triangle_locator_2d.h"
+#include "elastic/particles/face_folds.h"
 
 namespace elastic {
 
@@ -296,22 +297,18 @@ InitialMap naive_map(const ParticleGrid& grid, const RegionDiskMap& source,
 
 namespace {
 
-// Faces of the naive map that fold against the target surface's normals at the particles (the
-// solver's own fold test, SpringSystem::folded_faces).
-int naive_folds(const SpringSystem& springs, const InitialMap& naive, const LimitSurface& surface) {
+// Faces of the naive map that fold against the target surface: the one fold definition
+// (particles/face_folds.h), with the unit normals at the particles.
+int naive_folds(const ParticleGrid& grid, const InitialMap& naive, const LimitSurface& surface) {
   const auto n = static_cast<Eigen::Index>(naive.points.size());
   Eigen::Matrix3Xd normals(3, n);
   tbb::parallel_for(
       tbb::blocked_range<Eigen::Index>(0, n, 512), [&](const tbb::blocked_range<Eigen::Index>& r) {
         for (Eigen::Index i = r.begin(); i != r.end(); ++i) {
-          const SurfaceDerivatives d =
-              surface.derivatives(naive.points[static_cast<std::size_t>(i)]);
-          const Eigen::Vector3d normal = d.du.cross(d.dv);
-          normals.col(i) =
-              normal.norm() > 0.0 ? Eigen::Vector3d(normal.normalized()) : Eigen::Vector3d::Zero();
+          normals.col(i) = surface.curvature(naive.points[static_cast<std::size_t>(i)]).normal;
         }
       });
-  return springs.folded_faces(naive.positions, normals);
+  return inverted_faces(grid, naive.positions, normals);
 }
 
 }  // namespace
@@ -353,7 +350,7 @@ BoundaryOffsetResult choose_boundary_offset(const ParticleGrid& grid, const Regi
       break;
     }
     target.set_offset(static_cast<double>(k) / options.candidates);
-    const int folds = naive_folds(springs, place_on_target(from, target), surface);
+    const int folds = naive_folds(grid, place_on_target(from, target), surface);
     if (folds < fewest) {
       fewest = folds;
       result.offset = static_cast<double>(k) / options.candidates;

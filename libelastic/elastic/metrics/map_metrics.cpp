@@ -9,6 +9,7 @@
 #include <string>
 
 #include "elastic/core/error.h"
+#include "elastic/particles/face_folds.h"
 
 namespace elastic {
 
@@ -96,29 +97,6 @@ bool analyse_pair(const Eigen::Vector3d& p0, const Eigen::Vector3d& p1, const Ei
   out.s1 = 0.5 * (plus + minus);
   out.s2 = out.s1 > 0.0 ? out.prod / out.s1 : 0.0;
   return true;
-}
-
-// The triangles of every triangulation of a face with `n` corners that the fold test looks at, as
-// corner positions within the face: a triangle is itself; a quad has two triangulations (the
-// diagonals 0-2 and 1-3), four triangles in all, one per omitted corner; a larger polygon the fans
-// from each of its corners.
-const std::vector<Eigen::Vector3i>& face_triangulations(int n) {
-  static const std::vector<Eigen::Vector3i> triangle = {{0, 1, 2}};
-  static const std::vector<Eigen::Vector3i> quad = {{0, 1, 2}, {0, 2, 3}, {1, 2, 3}, {1, 3, 0}};
-  if (n == 3) {
-    return triangle;
-  }
-  if (n == 4) {
-    return quad;
-  }
-  thread_local std::vector<Eigen::Vector3i> fans;
-  fans.clear();
-  for (int a = 0; a < n; ++a) {
-    for (int k = 1; k + 1 < n; ++k) {
-      fans.emplace_back(a, (a + k) % n, (a + k + 1) % n);
-    }
-  }
-  return fans;
 }
 
 }  // namespace
@@ -313,10 +291,9 @@ int judge_faces(const ParticleGrid& grid, const Eigen::Matrix3Xd& source,
       if (have_normals) {
         // Inverted when the target triangle's normal points against the surface: compare with the
         // sum of the three corners' unit normals (robust to one corner normal being off).
-        const Eigen::Vector3d surface_normal = options.target_normals.col(a) +
-                                               options.target_normals.col(b) +
-                                               options.target_normals.col(c);
-        inverted = pair.target_normal.dot(surface_normal) <= 0.0;
+        inverted = triangle_inverted(target_positions.col(a), target_positions.col(b),
+                                     target_positions.col(c), options.target_normals.col(a),
+                                     options.target_normals.col(b), options.target_normals.col(c));
       }
       degenerate = degenerate || flat;
       folded = folded || flat || inverted;
