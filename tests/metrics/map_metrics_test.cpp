@@ -13,6 +13,7 @@
 #include <utility>
 
 #include "elastic/core/error.h"
+#include "elastic/particles/face_folds.h"
 
 namespace elastic {
 namespace {
@@ -291,6 +292,12 @@ TEST(MapMetrics, QuadFoldedOnlyAlongItsOtherDiagonalIsFolded) {
   EXPECT_EQ(m.degenerate, 0);
   EXPECT_NEAR(m.sigma_min, -0.4, kTight);
   EXPECT_NEAR(m.per_face.sigma_min[0], -0.4, kTight);
+  // The same test below the metrics (particles/face_folds.h, the naive map's offset choice uses
+  // it): the moved quad is inverted, the unmoved one is not, and seen from below (normals -z) it
+  // is.
+  EXPECT_EQ(inverted_faces(grid, y, options.target_normals), 1);
+  EXPECT_EQ(inverted_faces(grid, grid.source_positions(), options.target_normals), 0);
+  EXPECT_EQ(inverted_faces(grid, grid.source_positions(), -options.target_normals), 1);
   // Both fan triangles are positive: s1 s2 = det = 0.3, s1^2 + s2^2 = |J|_F^2 = 1.58.
   const double s2 = 0.5 * (std::sqrt(1.58 + 0.6) - std::sqrt(1.58 - 0.6));
   for (int t = 0; t < 2; ++t) {
