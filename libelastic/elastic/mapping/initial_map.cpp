@@ -10,6 +10,7 @@
 #include <map>
 #include <numbers>
 #include <numeric>
+#include <optional>
 
 #include "elastic/core/error.h"
 #include "elastic/core/triangle_locator_2d.h"
@@ -325,12 +326,21 @@ BoundaryOffsetResult choose_boundary_offset(const ParticleGrid& grid, const Regi
   // The source half of the naive map does not turn with the offset: computed once.
   const SourceDiskPoints from = source_disk_points(grid, source);
   std::vector<double> energy(static_cast<std::size_t>(options.candidates));
+  // The least-energy candidate's placement is kept: it is the one tested for folds first, and
+  // usually the one returned.
+  std::optional<InitialMap> lowest;
+  int lowest_k = -1;
   for (int k = 0; k < options.candidates; ++k) {
     target.set_offset(static_cast<double>(k) / options.candidates);
-    const InitialMap naive = place_on_target(from, target);
+    InitialMap naive = place_on_target(from, target);
     energy[static_cast<std::size_t>(k)] = naive.outside > 0
                                               ? std::numeric_limits<double>::infinity()
                                               : springs.evaluate(naive.positions).total();
+    if (lowest_k < 0 ||
+        energy[static_cast<std::size_t>(k)] < energy[static_cast<std::size_t>(lowest_k)]) {
+      lowest = std::move(naive);
+      lowest_k = k;
+    }
   }
   result.energy_at_zero = energy[0];
   // By energy (ties keep the smaller offset: the region's own anchor first); the first whose naive
@@ -350,12 +360,14 @@ BoundaryOffsetResult choose_boundary_offset(const ParticleGrid& grid, const Regi
       break;
     }
     target.set_offset(static_cast<double>(k) / options.candidates);
-    const int folds = naive_folds(grid, place_on_target(from, target), surface);
+    InitialMap naive = k == lowest_k ? std::move(*lowest) : place_on_target(from, target);
+    const int folds = naive_folds(grid, naive, surface);
     if (folds < fewest) {
       fewest = folds;
       result.offset = static_cast<double>(k) / options.candidates;
       result.energy = energy[static_cast<std::size_t>(k)];
       result.folds = folds;
+      result.naive = std::move(naive);
     }
     if (folds == 0) {
       break;

@@ -81,6 +81,7 @@ struct BoundaryOffsetResult {
   double energy_at_zero = 0.0;  ///< the same with the region's own anchor (offset 0)
   int folds = 0;                ///< faces the chosen offset's naive map folds
   int candidates = 0;           ///< offsets tried
+  InitialMap naive;             ///< the naive map with the chosen offset (naive_map's answer)
 };
 
 /// Chooses where the boundary correspondence starts on the target (when no anchor says so): the

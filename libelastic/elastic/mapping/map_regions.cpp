@@ -56,7 +56,7 @@ MapResult map_regions(const SurfaceProjector& source, const Region& source_regio
   result.rest_scale = rest_scale_factor(options.rest_scale, sizes);
 
   if (options.choose_offset && !source_region.anchor_given && !target_region.anchor_given) {
-    const BoundaryOffsetResult offset = choose_boundary_offset(
+    BoundaryOffsetResult offset = choose_boundary_offset(
         grid, *result.source_disk, *result.target_disk,
         {.candidates = options.offset_candidates,
          .energy = {.stiffness = options.relaxation.stiffness,
@@ -67,8 +67,10 @@ MapResult map_regions(const SurfaceProjector& source, const Region& source_regio
     result.offset_energy = offset.energy;
     result.offset_energy_at_zero = offset.energy_at_zero;
     result.offset_folds = offset.folds;
+    result.naive = std::move(offset.naive);  // already placed with the chosen offset
+  } else {
+    result.naive = naive_map(grid, *result.source_disk, *result.target_disk);
   }
-  result.naive = naive_map(grid, *result.source_disk, *result.target_disk);
   if (result.naive.outside > 0) {
     throw NumericalError("map", std::to_string(result.naive.outside) +
                                     " particles could not be placed in the target region");

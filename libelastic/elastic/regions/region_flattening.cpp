@@ -161,9 +161,6 @@ std::optional<std::vector<Eigen::Vector2d>> planar_coordinates(const Region& reg
       return std::nullopt;
     }
   }
-  if (std::abs(e1.dot(normal)) > 1e-12) {
-    return std::nullopt;
-  }
   const Eigen::Vector3d e2 = normal.cross(e1);
   std::vector<Eigen::Vector2d> uv;
   uv.reserve(x.size());
