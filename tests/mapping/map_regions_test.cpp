@@ -175,7 +175,14 @@ TEST(MapRegions, SlidePhaseStopsAtItsOwnTolerance) {
   EXPECT_EQ(loose.relaxation.boundary, BoundaryMode::Slide);
   EXPECT_EQ(loose.relaxation.slide_reason, StopReason::RelativeGradient);
   EXPECT_LT(loose.relaxation.slide_iterations, full.relaxation.slide_iterations);
-  EXPECT_LE(loose.relaxation.relative_gradient, options.relaxation.relative_gradient_tolerance);
+  // The held phase converges by the full tolerance, or by round-off (docs/solvers.md: the energy no
+  // longer changes and |P g| is within 1e-4 of the start's), far below the slide's 1e-2 either way.
+  if (loose.relaxation.reason == StopReason::RoundOff) {
+    EXPECT_LE(loose.relaxation.relative_gradient, options.relaxation.round_off_gradient_tolerance);
+  } else {
+    EXPECT_EQ(loose.relaxation.reason, StopReason::RelativeGradient);
+    EXPECT_LE(loose.relaxation.relative_gradient, options.relaxation.relative_gradient_tolerance);
+  }
   EXPECT_LT(energy(loose.relaxation), 1.005 * energy(full.relaxation));
   EXPECT_LT(energy(loose.relaxation), energy(fixed.relaxation));
   for (const double bad : {-1.0, std::numeric_limits<double>::quiet_NaN()}) {

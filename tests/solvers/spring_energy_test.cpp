@@ -196,6 +196,34 @@ TEST(SpringEnergy, BarrierValueOfAUniformCompression) {
   EXPECT_TRUE(std::isinf(system.evaluate(line).barrier));
 }
 
+// The target's units are the user's: with the rest scale sigma and the positions both multiplied
+// by lambda, every term (springs and barrier alike) is multiplied by lambda^2, so the minimiser is
+// the same map whatever the two meshes' units. (The barrier once weighed the source area without
+// sigma^2: on a head in millimetres, sigma ~ 45, it was 2000 times weaker against the springs than
+// on a unit-sized target, and triangles collapsed to sigma_min 0.13.)
+TEST(SpringEnergy, EveryTermScalesWithTheSquareOfTheTargetUnits) {
+  const ParticleGrid grid = test::make_quad_grid(5, 4, 1.0);
+  // Compressed to 0.45 and shaken, so that the barrier is active.
+  const Eigen::Matrix3Xd x = 0.45 * random_configuration(grid, 0.2, 11);
+  const auto energies = [&](double lambda) {
+    const SpringSystem system(grid, {.stiffness = 1.3,
+                                     .angular_stiffness = 0.4,
+                                     .rest_scale = 0.8 * lambda,
+                                     .barrier_stiffness = 2.0,
+                                     .barrier_sigma = 0.4});
+    return system.evaluate(Eigen::Matrix3Xd(lambda * x));
+  };
+  const SpringEnergies unit = energies(1.0);
+  ASSERT_GT(unit.barrier, 0.0);
+  for (const double lambda : {1e-3, 0.37, 44.7, 2.5e3}) {
+    const SpringEnergies scaled = energies(lambda);
+    const double l2 = lambda * lambda;
+    EXPECT_NEAR(scaled.length, l2 * unit.length, 1e-10 * l2 * unit.length) << lambda;
+    EXPECT_NEAR(scaled.angular, l2 * unit.angular, 1e-10 * l2 * unit.angular) << lambda;
+    EXPECT_NEAR(scaled.barrier, l2 * unit.barrier, 1e-10 * l2 * unit.barrier) << lambda;
+  }
+}
+
 TEST(SpringEnergy, ForcesConserveLinearAndAngularMomentum) {
   // Internal forces of a translation- and rotation-invariant energy sum to zero and have zero total
   // torque.

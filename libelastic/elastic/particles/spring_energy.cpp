@@ -211,7 +211,10 @@ void SpringSystem::build_barrier(const ParticleGrid& grid) {
       t.i = corner.i;
       t.next = corner.next;
       t.prev = corner.prev;
-      t.weight = weight * 0.5 * std::sqrt(det);  // w A_s, A_s = sqrt(det(S^T S)) / 2
+      // w sigma^2 A_s, A_s = sqrt(det(S^T S)) / 2: the rest area at the target's scale, as the
+      // springs' rest lengths are sigma k, so the barrier weighs the same against the springs
+      // whatever the ratio of the two meshes' units.
+      t.weight = weight * options_.rest_scale * options_.rest_scale * 0.5 * std::sqrt(det);
       t.b00 = g11 / det;
       t.b01 = -g01 / det;
       t.b11 = g00 / det;

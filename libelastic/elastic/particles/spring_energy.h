@@ -24,10 +24,12 @@
 ///   we keep its force.
 ///
 /// - injectivity barrier (beyond the paper; SpringEnergyOptions::barrier_stiffness > 0):
-///       E_bar = mu * sum_{triangles t} w_t A_t * h(g_t),
-///       h(g) = (g / g0 - 1)^2 for g > g0, else 0
+///       E_bar = mu * sum_{triangles t} w_t sigma^2 A_t * h(g_t),
+///       h(g) = (g / g0 - 1)^3 for g > g0, else 0
 ///   over every triangle of both triangulations of each quad (weight w = 1/2, so each split covers
-///   the quad once) and every triangle face (w = 1); A_t is the source area and
+///   the quad once) and every triangle face (w = 1); A_t is the source area (sigma^2 A_t the rest
+///   area at the target's scale, so that E_bar, like the springs, scales with the square of the
+///   target's units and the minimiser does not depend on them) and
 ///   g_t = s1^-2 + s2^-2 the inverse part of the symmetric Dirichlet energy of the triangle's
 ///   affine map divided by sigma (s1, s2 its singular values, as in metrics/map_metrics.h). In
 ///   Gram-matrix form, with S, T the 3 x 2 edge matrices of the source and target triangle:

@@ -162,8 +162,12 @@ struct RelaxationOptions {
   /// The energy. The barrier of EnergyKind::Robust is used by the fast solver; the faithful
   /// solver (the paper's explicit integrator) always integrates the paper's forces.
   EnergyKind energy = EnergyKind::Robust;
-  /// mu of the barrier relative to C (SpringEnergyOptions::barrier_stiffness); Robust only.
-  double barrier_stiffness = 1.0;
+  /// mu of the barrier relative to C (SpringEnergyOptions::barrier_stiffness); Robust only. 15:
+  /// the value that held sigma_min >= 0.2 on the sharp-cornered sources of the robustness
+  /// benchmark (36 and 60 degree tips opened to 180) without costing more length energy than the
+  /// benchmark's bar allows; 10 let the star's tips fall to 0.19, 25 and more cost length energy
+  /// (docs/solvers.md).
+  double barrier_stiffness = 15.0;
   /// Smaller stretch below which the barrier acts (SpringEnergyOptions::barrier_sigma).
   double barrier_sigma = 0.4;
   double stiffness = 1.0;  ///< C of the normal springs (eq. 13)
