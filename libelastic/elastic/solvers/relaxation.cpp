@@ -3,12 +3,12 @@
 #include <tbb/task_arena.h>
 
 #include <algorithm>
-#include <cmath>
 #include <string>
 
 #include "elastic/core/error.h"
 #include "elastic/solvers/explicit_integrator.h"
 #include "elastic/solvers/lbfgs_solver.h"
+#include "elastic/solvers/solver_common.h"
 
 namespace elastic {
 
@@ -180,17 +180,9 @@ RelaxationResult restart_with_full_barrier(const RelaxationProblem& problem,
   again.reference_gradient_norm = first.initial_gradient_norm;
   RelaxationResult result = relax_lbfgs(again, options);
   if (result.boundary == BoundaryMode::Slide) {
-    // The restart measured its slide from its own start: measure it from the problem's (periodic
-    // parameters: the shorter way round).
-    const std::vector<double>& start = problem.boundary_parameters.empty()
-                                           ? problem.grid->boundary_parameter
-                                           : problem.boundary_parameters;
-    result.boundary_slide = 0.0;
-    for (std::size_t k = 0; k < start.size() && k < result.boundary_parameters.size(); ++k) {
-      const double d = std::abs(result.boundary_parameters[k] - start[k]);
-      const double wrapped = d - std::floor(d);
-      result.boundary_slide = std::max(result.boundary_slide, std::min(wrapped, 1.0 - wrapped));
-    }
+    // The restart measured its slide from its own start: measure it from the problem's.
+    result.boundary_slide = solver_detail::boundary_slide(solver_detail::boundary_start(problem),
+                                                          result.boundary_parameters);
   }
   result.initial_energy = first.initial_energy;
   result.initial_folded_faces = first.initial_folded_faces;

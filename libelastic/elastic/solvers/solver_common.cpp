@@ -251,22 +251,17 @@ void finish_result(const RelaxationSetup& setup, const RelaxationProblem& proble
   result.boundary = setup.slide ? BoundaryMode::Slide : BoundaryMode::Fixed;
   if (setup.slide) {
     // On the curve by construction: measured against the curve point at each final parameter.
-    const std::vector<double>& start = problem.boundary_parameters.empty()
-                                           ? setup.grid.boundary_parameter
-                                           : problem.boundary_parameters;
     result.boundary_parameters = setup.curve_s;
     result.boundary_residual = 0.0;
-    result.boundary_slide = 0.0;
     for (std::size_t k = 0; k < setup.curve_s.size(); ++k) {
       const double s = setup.curve_s[k] - std::floor(setup.curve_s[k]);
       const Eigen::Vector3d on_curve = setup.target.surface().position((*setup.curve)(s));
       const int p = setup.grid.boundary_loop[k];
       result.boundary_residual =
           std::max(result.boundary_residual, (setup.positions.col(p) - on_curve).norm());
-      result.boundary_slide =
-          std::max(result.boundary_slide, std::abs(setup.curve_s[k] - start[k]));
       result.boundary_parameters[k] = s;
     }
+    result.boundary_slide = boundary_slide(boundary_start(problem), result.boundary_parameters);
   } else {
     result.boundary_parameters = problem.boundary_parameters.empty() ? setup.grid.boundary_parameter
                                                                      : problem.boundary_parameters;
@@ -275,6 +270,21 @@ void finish_result(const RelaxationSetup& setup, const RelaxationProblem& proble
   result.rest_scale = problem.rest_scale;
   result.rest_scale_mode = problem.rest_scale_mode;
   result.converged = is_converged(result.reason);
+}
+
+const std::vector<double>& boundary_start(const RelaxationProblem& problem) {
+  return problem.boundary_parameters.empty() ? problem.grid->boundary_parameter
+                                             : problem.boundary_parameters;
+}
+
+double boundary_slide(const std::vector<double>& start, const std::vector<double>& end) {
+  double slide = 0.0;
+  for (std::size_t k = 0; k < start.size() && k < end.size(); ++k) {
+    const double d = std::abs(end[k] - start[k]);
+    const double wrapped = d - std::floor(d);
+    slide = std::max(slide, std::min(wrapped, 1.0 - wrapped));
+  }
+  return slide;
 }
 
 }  // namespace elastic::solver_detail

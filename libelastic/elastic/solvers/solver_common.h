@@ -79,4 +79,11 @@ void finish_result(const RelaxationSetup& setup, const RelaxationProblem& proble
 /// (problem.boundary_targets, or the initial position when that is empty).
 double boundary_residual(const RelaxationProblem& problem, const Eigen::Matrix3Xd& positions);
 
+/// The start parameters of a sliding boundary: problem.boundary_parameters, or the grid's.
+const std::vector<double>& boundary_start(const RelaxationProblem& problem);
+
+/// RelaxationResult::boundary_slide: the largest distance from `start` to `end` of one boundary
+/// particle's correspondence parameter (period 1, the shorter way round).
+double boundary_slide(const std::vector<double>& start, const std::vector<double>& end);
+
 }  // namespace elastic::solver_detail
