@@ -264,12 +264,7 @@ void check_region(const Region& region, const SurfaceProjector& projector,
   }
 }
 
-}  // namespace
-
-BaselineResult map_baseline(const ParticleGrid& grid, const SurfaceProjector& source,
-                            const Region& source_region, const SurfaceProjector& target,
-                            const Region& target_region, const BaselineOptions& options) {
-  const auto start = std::chrono::steady_clock::now();
+void check_grid(const ParticleGrid& grid) {
   const int n = grid.num_particles();
   if (n == 0) {
     throw InvalidInputError("grid", "particle grid is empty");
@@ -282,16 +277,13 @@ BaselineResult map_baseline(const ParticleGrid& grid, const SurfaceProjector& so
   if (grid.boundary_loop.empty()) {
     throw InvalidInputError("grid", "particle grid has no boundary");
   }
-  check_region(source_region, source, "source region");
-  check_region(target_region, target, "target region");
-  if (options.alignment_samples < 3) {
-    throw InvalidInputError("baseline options", "alignment_samples must be at least 3");
-  }
+}
 
-  BaselineResult result;
-  result.kind = options.kind;
-
-  // 1. Both flattenings (independent: run side by side).
+// Both flattenings, side by side (they are independent). Each task keeps its own exception, so
+// that when both fail the error is always the source's.
+std::pair<CgalFlattening, CgalFlattening> flatten_both(const Region& source_region,
+                                                       const Region& target_region,
+                                                       const BaselineOptions& options) {
   const CgalFlatteningOptions flattening{.arap_iterations = options.arap_iterations,
                                          .arap_lambda = options.arap_lambda,
                                          .arap_tolerance = options.arap_tolerance,
@@ -300,7 +292,6 @@ BaselineResult map_baseline(const ParticleGrid& grid, const SurfaceProjector& so
   CgalFlatteningOptions target_flattening = flattening;
   target_flattening.name = "target region";
   CgalFlattening from, to;
-  // Each task keeps its own exception, so that when both fail the error is always the source's.
   std::exception_ptr source_error, target_error;
   tbb::parallel_invoke(
       [&] {
@@ -323,23 +314,27 @@ BaselineResult map_baseline(const ParticleGrid& grid, const SurfaceProjector& so
   if (target_error) {
     std::rethrow_exception(target_error);
   }
-  result.source_flipped_triangles = from.flipped_triangles;
-  result.target_flipped_triangles = to.flipped_triangles;
+  return {std::move(from), std::move(to)};
+}
 
-  // 2. Alignment: the similarity z -> a z + b (complex a: rotation and scale, never a reflection)
-  //    minimising sum_j |a p_j + b - q_j|^2 over boundary samples at common parameters s_j = j / N
-  //    (Umeyama 1991 in complex form: b matches the centroids, a = <p', q'> / |p'|^2 on the
-  //    centred samples).
-  const BoundaryParametrisation source_boundary(source_region, "source region");
-  const BoundaryParametrisation target_boundary(target_region, "target region",
-                                                options.target_offset);
-  const int samples = options.alignment_samples;
+// The similarity z -> a z + b (complex a: rotation and scale, never a reflection) minimising
+// sum_j |a p_j + b - q_j|^2 over boundary samples at common parameters s_j = j / N (Umeyama 1991
+// in complex form: b matches the centroids, a = <p', q'> / |p'|^2 on the centred samples).
+struct Similarity {
+  Complex a = 1.0, b = 0.0;
+  double rms = 0.0;  // of the samples' residuals
+};
+
+Similarity align_boundaries(const BoundaryParametrisation& source_boundary,
+                            const std::vector<Eigen::Vector2d>& source_uv,
+                            const BoundaryParametrisation& target_boundary,
+                            const std::vector<Eigen::Vector2d>& target_uv, int samples) {
   std::vector<Complex> p(static_cast<size_t>(samples)), q(static_cast<size_t>(samples));
   Complex p_mean = 0.0, q_mean = 0.0;
   for (int j = 0; j < samples; ++j) {
     const double s = static_cast<double>(j) / samples;
-    const Eigen::Vector2d ps = source_boundary.planar(s, from.uv);
-    const Eigen::Vector2d qs = target_boundary.planar(s, to.uv);
+    const Eigen::Vector2d ps = source_boundary.planar(s, source_uv);
+    const Eigen::Vector2d qs = target_boundary.planar(s, target_uv);
     p[static_cast<size_t>(j)] = {ps.x(), ps.y()};
     q[static_cast<size_t>(j)] = {qs.x(), qs.y()};
     p_mean += p[static_cast<size_t>(j)];
@@ -357,22 +352,24 @@ BaselineResult map_baseline(const ParticleGrid& grid, const SurfaceProjector& so
   if (!(norm2 > 0.0)) {
     throw NumericalError("source region", "flattened boundary collapsed to a point");
   }
-  const Complex a = cross / norm2;
-  const Complex b = q_mean - a * p_mean;
-  if (!(std::abs(a) > 0.0)) {
+  Similarity out;
+  out.a = cross / norm2;
+  out.b = q_mean - out.a * p_mean;
+  if (!(std::abs(out.a) > 0.0)) {
     throw NumericalError("target region",
                          "flattened boundaries are uncorrelated (zero alignment scale)");
   }
   double residual2 = 0.0;
   for (int j = 0; j < samples; ++j) {
-    residual2 += std::norm(a * p[static_cast<size_t>(j)] + b - q[static_cast<size_t>(j)]);
+    residual2 += std::norm(out.a * p[static_cast<size_t>(j)] + out.b - q[static_cast<size_t>(j)]);
   }
-  result.alignment_scale = std::abs(a);
-  result.alignment_rotation = std::arg(a);
-  result.alignment_translation = {b.real(), b.imag()};
-  result.alignment_rms = std::sqrt(residual2 / samples);
+  out.rms = std::sqrt(residual2 / samples);
+  return out;
+}
 
-  // 3. Composition. Boundary particles: exactly at their parameter on the target curve.
+// Per particle: its parameter on the boundary curve, or -1 for interior particles.
+std::vector<double> boundary_parameters(const ParticleGrid& grid) {
+  const int n = grid.num_particles();
   std::vector<double> parameter(static_cast<size_t>(n), -1.0);
   for (size_t k = 0; k < grid.boundary_loop.size(); ++k) {
     const int i = grid.boundary_loop[k];
@@ -381,61 +378,138 @@ BaselineResult map_baseline(const ParticleGrid& grid, const SurfaceProjector& so
     }
     parameter[static_cast<size_t>(i)] = grid.boundary_parameter[k];
   }
-  result.positions.resize(3, n);
-  result.points.assign(static_cast<size_t>(n), SurfacePoint{});
-  result.outside.assign(static_cast<size_t>(n), 0);
-  const LimitSurface& target_surface = target.surface();
-  const RegionPointLocator source_locator(source_region);
-  const TriangleLocator2D target_locator(to.uv, target_region.triangles);
-  std::vector<char> unlocated(static_cast<size_t>(n), 0);
-  tbb::parallel_for(tbb::blocked_range<int>(0, n, 64), [&](const tbb::blocked_range<int>& range) {
-    for (int i = range.begin(); i != range.end(); ++i) {
-      const size_t ii = static_cast<size_t>(i);
-      if (parameter[ii] >= 0.0) {
-        const SurfacePoint point = target_boundary.point(parameter[ii]);
-        result.points[ii] = point;
-        result.positions.col(i) = target_surface.position(point);
-        continue;
+  return parameter;
+}
+
+// The composition target^-1 o similarity o source of step 3 (see the header), written into
+// result's positions, points and outside flags.
+class Composition {
+ public:
+  Composition(const ParticleGrid& grid, const Region& source_region, const Region& target_region,
+              const LimitSurface& target_surface, const CgalFlattening& from,
+              const CgalFlattening& to, const BoundaryParametrisation& target_boundary,
+              const Similarity& similarity, const BaselineOptions& options)
+      : grid_(grid),
+        source_region_(source_region),
+        target_region_(target_region),
+        target_surface_(target_surface),
+        from_(from),
+        target_boundary_(target_boundary),
+        similarity_(similarity),
+        options_(options),
+        source_locator_(source_region),
+        target_locator_(to.uv, target_region.triangles) {}
+
+  void run(BaselineResult& result) const {
+    const int n = grid_.num_particles();
+    const std::vector<double> parameter = boundary_parameters(grid_);
+    result.positions.resize(3, n);
+    result.points.assign(static_cast<size_t>(n), SurfacePoint{});
+    result.outside.assign(static_cast<size_t>(n), 0);
+    std::vector<char> unlocated(static_cast<size_t>(n), 0);
+    tbb::parallel_for(tbb::blocked_range<int>(0, n, 64), [&](const tbb::blocked_range<int>& r) {
+      for (int i = r.begin(); i != r.end(); ++i) {
+        const auto ii = static_cast<size_t>(i);
+        if (parameter[ii] >= 0.0) {  // boundary particles: exactly at their parameter
+          const SurfacePoint point = target_boundary_.point(parameter[ii]);
+          result.points[ii] = point;
+          result.positions.col(i) = target_surface_.position(point);
+        } else if (!place_interior(i, result)) {
+          unlocated[ii] = 1;
+        }
       }
-      const auto& x = grid.mesh.point(GridMesh::VertexHandle(i));
-      int t = -1;
-      Eigen::Vector3d w = Eigen::Vector3d::Zero();
-      if (!source_locator.locate(grid.source_points[ii], Eigen::Vector3d(x[0], x[1], x[2]),
-                                 options.locate_tolerance, t, w)) {
-        unlocated[ii] = 1;
-        continue;
+    });
+    for (int i = 0; i < n; ++i) {
+      if (unlocated[static_cast<size_t>(i)]) {
+        throw InvalidInputError("grid", "particle " + std::to_string(i) +
+                                            "'s source point is not in the source region");
       }
-      const Eigen::Vector3i& tri = source_region.triangles[static_cast<size_t>(t)];
-      const Eigen::Vector2d plane = w[0] * from.uv[static_cast<size_t>(tri[0])] +
-                                    w[1] * from.uv[static_cast<size_t>(tri[1])] +
-                                    w[2] * from.uv[static_cast<size_t>(tri[2])];
-      const Complex z = a * Complex(plane.x(), plane.y()) + b;
-      const Eigen::Vector2d aligned(z.real(), z.imag());
-      const TriangleLocator2D::Hit hit = target_locator.locate(aligned, options.locate_tolerance);
-      if (hit.found()) {
-        const Eigen::Vector3d c =
-            hit.barycentric.cwiseMax(0.0) / hit.barycentric.cwiseMax(0.0).sum();
-        const SurfacePoint point = target_region.point_in_triangle(hit.triangle, c[1], c[2]);
-        result.points[ii] = point;
-        result.positions.col(i) = target_surface.position(point);
-      } else {
-        // Outside the target flattening: flagged, its SurfacePoint left unset; its position is the
-        // nearest point of the target flattening (on its boundary), so it stays on the surface.
-        result.outside[ii] = 1;
-        const TriangleLocator2D::Hit nearest = target_locator.nearest(aligned);
-        const SurfacePoint point = target_region.point_in_triangle(
-            nearest.triangle, nearest.barycentric[1], nearest.barycentric[2]);
-        result.positions.col(i) = target_surface.position(point);
-      }
+      result.num_outside += result.outside[static_cast<size_t>(i)];
     }
-  });
-  for (int i = 0; i < n; ++i) {
-    if (unlocated[static_cast<size_t>(i)]) {
-      throw InvalidInputError(
-          "grid", "particle " + std::to_string(i) + "'s source point is not in the source region");
-    }
-    result.num_outside += result.outside[static_cast<size_t>(i)];
   }
+
+ private:
+  // False when the particle's source point is not in the source region.
+  bool place_interior(int i, BaselineResult& result) const {
+    const auto ii = static_cast<size_t>(i);
+    const auto& x = grid_.mesh.point(GridMesh::VertexHandle(i));
+    int t = -1;
+    Eigen::Vector3d w = Eigen::Vector3d::Zero();
+    if (!source_locator_.locate(grid_.source_points[ii], Eigen::Vector3d(x[0], x[1], x[2]),
+                                options_.locate_tolerance, t, w)) {
+      return false;
+    }
+    const Eigen::Vector3i& tri = source_region_.triangles[static_cast<size_t>(t)];
+    const Eigen::Vector2d plane = w[0] * from_.uv[static_cast<size_t>(tri[0])] +
+                                  w[1] * from_.uv[static_cast<size_t>(tri[1])] +
+                                  w[2] * from_.uv[static_cast<size_t>(tri[2])];
+    const Complex z = similarity_.a * Complex(plane.x(), plane.y()) + similarity_.b;
+    const Eigen::Vector2d aligned(z.real(), z.imag());
+    const TriangleLocator2D::Hit hit = target_locator_.locate(aligned, options_.locate_tolerance);
+    if (hit.found()) {
+      const Eigen::Vector3d c = hit.barycentric.cwiseMax(0.0) / hit.barycentric.cwiseMax(0.0).sum();
+      const SurfacePoint point = target_region_.point_in_triangle(hit.triangle, c[1], c[2]);
+      result.points[ii] = point;
+      result.positions.col(i) = target_surface_.position(point);
+    } else {
+      // Outside the target flattening: flagged, its SurfacePoint left unset; its position is the
+      // nearest point of the target flattening (on its boundary), so it stays on the surface.
+      result.outside[ii] = 1;
+      const TriangleLocator2D::Hit nearest = target_locator_.nearest(aligned);
+      const SurfacePoint point = target_region_.point_in_triangle(
+          nearest.triangle, nearest.barycentric[1], nearest.barycentric[2]);
+      result.positions.col(i) = target_surface_.position(point);
+    }
+    return true;
+  }
+
+  const ParticleGrid& grid_;
+  const Region& source_region_;
+  const Region& target_region_;
+  const LimitSurface& target_surface_;
+  const CgalFlattening& from_;
+  const BoundaryParametrisation& target_boundary_;
+  const Similarity& similarity_;
+  const BaselineOptions& options_;
+  const RegionPointLocator source_locator_;
+  const TriangleLocator2D target_locator_;
+};
+
+}  // namespace
+
+BaselineResult map_baseline(const ParticleGrid& grid, const SurfaceProjector& source,
+                            const Region& source_region, const SurfaceProjector& target,
+                            const Region& target_region, const BaselineOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  check_grid(grid);
+  check_region(source_region, source, "source region");
+  check_region(target_region, target, "target region");
+  if (options.alignment_samples < 3) {
+    throw InvalidInputError("baseline options", "alignment_samples must be at least 3");
+  }
+
+  BaselineResult result;
+  result.kind = options.kind;
+  // 1. Both flattenings.
+  const auto [from, to] = flatten_both(source_region, target_region, options);
+  result.source_flipped_triangles = from.flipped_triangles;
+  result.target_flipped_triangles = to.flipped_triangles;
+
+  // 2. Alignment of the flattened boundaries.
+  const BoundaryParametrisation source_boundary(source_region, "source region");
+  const BoundaryParametrisation target_boundary(target_region, "target region",
+                                                options.target_offset);
+  const Similarity similarity = align_boundaries(source_boundary, from.uv, target_boundary, to.uv,
+                                                 options.alignment_samples);
+  result.alignment_scale = std::abs(similarity.a);
+  result.alignment_rotation = std::arg(similarity.a);
+  result.alignment_translation = {similarity.b.real(), similarity.b.imag()};
+  result.alignment_rms = similarity.rms;
+
+  // 3. Composition.
+  Composition(grid, source_region, target_region, target.surface(), from, to, target_boundary,
+              similarity, options)
+      .run(result);
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;
 }

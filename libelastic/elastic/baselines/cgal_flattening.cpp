@@ -149,11 +149,8 @@ size_t nearest_parameter(const std::vector<double>& s, double target) {
   return best;
 }
 
-}  // namespace
-
-CgalFlattening flatten_region_cgal(const Region& region, BaselineKind kind,
-                                   const CgalFlatteningOptions& options) {
-  const std::string& name = options.name;
+// The region as a CGAL Surface_mesh: vertex i of the mesh is region vertex i.
+Mesh region_mesh(const Region& region, const std::string& name) {
   if (region.positions.empty() || region.triangles.empty()) {
     throw InvalidInputError(name, "region is empty (no triangles)");
   }
@@ -166,8 +163,6 @@ CgalFlattening flatten_region_cgal(const Region& region, BaselineKind kind,
       throw InvalidInputError(name, "boundary vertex index out of range");
     }
   }
-
-  // The region as a CGAL Surface_mesh: vertex i of the mesh is region vertex i.
   Mesh mesh;
   mesh.reserve(static_cast<Mesh::size_type>(nv), static_cast<Mesh::size_type>(3 * nv),
                static_cast<Mesh::size_type>(region.num_triangles()));
@@ -185,46 +180,57 @@ CgalFlattening flatten_region_cgal(const Region& region, BaselineKind kind,
       throw InvalidInputError(name, "region is not a manifold, consistently oriented mesh");
     }
   }
+  return mesh;
+}
 
-  // A topological disk: one border cycle and Euler characteristic 1 over the used vertices.
-  int border_cycles = 0;
-  HalfedgeIndex bhd = Mesh::null_halfedge();
-  {
-    std::vector<char> seen(mesh.number_of_halfedges(), 0);
-    for (HalfedgeIndex h : mesh.halfedges()) {
-      if (!mesh.is_border(h) || seen[h.idx()]) {
-        continue;
-      }
-      ++border_cycles;
-      for (HalfedgeIndex g : CGAL::halfedges_around_face(h, mesh)) {
-        seen[g.idx()] = 1;
-      }
-    }
-    // The border halfedge leaving boundary vertex 0: a deterministic start for CGAL's traversals.
-    const VertexIndex v0(static_cast<Mesh::size_type>(region.boundary[0]));
-    for (HalfedgeIndex h : CGAL::halfedges_around_source(v0, mesh)) {
-      if (mesh.is_border(h)) {
-        bhd = h;
-      }
-    }
-  }
+// The mesh's border halfedge leaving boundary vertex 0 (a deterministic start for CGAL's
+// traversals) and its used vertices, after checking that it is a topological disk: one border
+// cycle and Euler characteristic 1 over the used vertices.
+struct DiskBorder {
+  HalfedgeIndex start = Mesh::null_halfedge();
   long used_vertices = 0;
-  for (VertexIndex v : mesh.vertices()) {
-    used_vertices += mesh.is_isolated(v) ? 0 : 1;
+};
+
+DiskBorder disk_border(const Mesh& mesh, const Region& region, const std::string& name) {
+  DiskBorder out;
+  int border_cycles = 0;
+  std::vector<char> seen(mesh.number_of_halfedges(), 0);
+  for (HalfedgeIndex h : mesh.halfedges()) {
+    if (!mesh.is_border(h) || seen[h.idx()]) {
+      continue;
+    }
+    ++border_cycles;
+    for (HalfedgeIndex g : CGAL::halfedges_around_face(h, mesh)) {
+      seen[g.idx()] = 1;
+    }
   }
-  const long euler = used_vertices - static_cast<long>(mesh.number_of_edges()) +
+  const VertexIndex v0(static_cast<Mesh::size_type>(region.boundary[0]));
+  for (HalfedgeIndex h : CGAL::halfedges_around_source(v0, mesh)) {
+    if (mesh.is_border(h)) {
+      out.start = h;
+    }
+  }
+  for (VertexIndex v : mesh.vertices()) {
+    out.used_vertices += mesh.is_isolated(v) ? 0 : 1;
+  }
+  const long euler = out.used_vertices - static_cast<long>(mesh.number_of_edges()) +
                      static_cast<long>(mesh.number_of_faces());
-  if (border_cycles != 1 || euler != 1 || bhd == Mesh::null_halfedge()) {
+  if (border_cycles != 1 || euler != 1 || out.start == Mesh::null_halfedge()) {
     throw InvalidInputError(name, "region is not a topological disk with one boundary loop (" +
                                       std::to_string(border_cycles) +
                                       " boundary loops, Euler characteristic " +
                                       std::to_string(euler) + ")");
   }
+  return out;
+}
 
-  const std::vector<double> s = boundary_parameters(region);
-  auto uvmap = mesh.add_property_map<VertexIndex, Point2>("v:elastic_uv", Point2(0, 0)).first;
+using UvMap = Mesh::Property_map<VertexIndex, Point2>;
+
+// CGAL's parameterizer of `kind` into uvmap; s: the boundary vertices' parameters.
+void parameterize(Mesh& mesh, const Region& region, const std::vector<double>& s, BaselineKind kind,
+                  const DiskBorder& border, const CgalFlatteningOptions& options, UvMap uvmap) {
+  const std::string& name = options.name;
   SMP::Error_code status = SMP::OK;
-  const auto start = std::chrono::steady_clock::now();
   switch (kind) {
     case BaselineKind::Lscm: {
       // Two pins make LSCM's minimiser unique; which vertices are pinned changes the map
@@ -236,16 +242,16 @@ CgalFlattening flatten_region_cgal(const Region& region, BaselineKind kind,
           VertexIndex(static_cast<Mesh::size_type>(region.boundary[nearest_parameter(s, 0.5)]));
       using Border = SMP::Two_vertices_parameterizer_3<Mesh>;
       using Parameterizer = SMP::LSCM_parameterizer_3<Mesh, Border>;
-      status = SMP::parameterize(mesh, Parameterizer(Border(a, b)), bhd, uvmap);
+      status = SMP::parameterize(mesh, Parameterizer(Border(a, b)), border.start, uvmap);
       break;
     }
     case BaselineKind::Arap: {
       if (options.arap_iterations < 1) {
         throw InvalidInputError(name, "ARAP needs at least one iteration");
       }
-      if (used_vertices > options.arap_max_vertices) {
+      if (border.used_vertices > options.arap_max_vertices) {
         throw NumericalError(
-            name, "region has " + std::to_string(used_vertices) +
+            name, "region has " + std::to_string(border.used_vertices) +
                       " vertices, more than ARAP's limit of " +
                       std::to_string(options.arap_max_vertices) +
                       " (CGAL's ARAP post-processor is quadratic in the region size; coarsen "
@@ -256,13 +262,13 @@ CgalFlattening flatten_region_cgal(const Region& region, BaselineKind kind,
       Parameterizer parameterizer(
           Parameterizer::Border_parameterizer(), CachedSparseLuTraits(), options.arap_lambda,
           static_cast<unsigned int>(options.arap_iterations), options.arap_tolerance);
-      status = SMP::parameterize(mesh, parameterizer, bhd, uvmap);
+      status = SMP::parameterize(mesh, parameterizer, border.start, uvmap);
       break;
     }
     case BaselineKind::Dcm: {
       using Parameterizer = SMP::Discrete_conformal_map_parameterizer_3<Mesh, AnchoredCircleBorder>;
-      status =
-          SMP::parameterize(mesh, Parameterizer(AnchoredCircleBorder(&region, &s)), bhd, uvmap);
+      status = SMP::parameterize(mesh, Parameterizer(AnchoredCircleBorder(&region, &s)),
+                                 border.start, uvmap);
       break;
     }
   }
@@ -270,15 +276,12 @@ CgalFlattening flatten_region_cgal(const Region& region, BaselineKind kind,
     throw NumericalError(
         name, std::string("CGAL parameterization failed: ") + SMP::get_error_message(status));
   }
+}
 
-  CgalFlattening result;
-  result.seconds_parameterize =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  result.uv.resize(static_cast<size_t>(nv));
-  for (VertexIndex v : mesh.vertices()) {
-    const Point2& p = uvmap[v];
-    result.uv[v.idx()] = Eigen::Vector2d(p.x(), p.y());
-  }
+// Scales the flattening to the region's 3D area and reflects a mirrored embedding (as good as
+// any) so that both regions' flattenings have the orientation of their triangles (the alignment
+// fits rotations only, never reflections); counts the triangles left flipped.
+void normalise(const Region& region, const std::string& name, CgalFlattening& result) {
   auto signed_area = [&](const Eigen::Vector3i& t) {
     const Eigen::Vector2d e1 =
         result.uv[static_cast<size_t>(t[1])] - result.uv[static_cast<size_t>(t[0])];
@@ -294,8 +297,6 @@ CgalFlattening flatten_region_cgal(const Region& region, BaselineKind kind,
   if (!(area3d > 0.0) || !std::isfinite(area) || area == 0.0) {
     throw NumericalError(name, "CGAL parameterization has zero or non-finite area");
   }
-  // A mirrored embedding is as good as any: reflect it so both regions' flattenings have the
-  // orientation of their triangles (the alignment fits rotations only, never reflections).
   const double mirror = area < 0.0 ? -1.0 : 1.0;
   result.scale = std::sqrt(area3d / std::abs(area));
   for (Eigen::Vector2d& p : result.uv) {
@@ -306,6 +307,27 @@ CgalFlattening flatten_region_cgal(const Region& region, BaselineKind kind,
       ++result.flipped_triangles;
     }
   }
+}
+
+}  // namespace
+
+CgalFlattening flatten_region_cgal(const Region& region, BaselineKind kind,
+                                   const CgalFlatteningOptions& options) {
+  Mesh mesh = region_mesh(region, options.name);
+  const DiskBorder border = disk_border(mesh, region, options.name);
+  const std::vector<double> s = boundary_parameters(region);
+  auto uvmap = mesh.add_property_map<VertexIndex, Point2>("v:elastic_uv", Point2(0, 0)).first;
+  const auto start = std::chrono::steady_clock::now();
+  parameterize(mesh, region, s, kind, border, options, uvmap);
+  CgalFlattening result;
+  result.seconds_parameterize =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  result.uv.resize(static_cast<size_t>(region.num_vertices()));
+  for (VertexIndex v : mesh.vertices()) {
+    const Point2& p = uvmap[v];
+    result.uv[v.idx()] = Eigen::Vector2d(p.x(), p.y());
+  }
+  normalise(region, options.name, result);
   return result;
 }
 

@@ -254,17 +254,28 @@ SpringEnergies SpringSystem::evaluate(const Eigen::Matrix3Xd& x, Eigen::Matrix3X
     throw InvalidInputError("particle positions", "expected " + std::to_string(num_particles_) +
                                                       " columns, got " + std::to_string(x.cols()));
   }
-  const std::vector<Spring>& springs = grid_->springs;
-  const std::vector<AngularSpring>& angular = grid_->angular_springs;
-  const double C = options_.stiffness;
-  const double Ca = options_.angular_stiffness;
-  const double sigma = options_.rest_scale;
   const bool want_gradient = gradient != nullptr;
-
-  // Normal springs, eq. 13: E = C (|d| - sigma k)^2, dE/dx_j = 2C (|d| - sigma k) d/|d| (eq. 14 up
-  // to the factor 2, see the header).
   SpringEnergies energies;
-  energies.length = tbb::parallel_deterministic_reduce(
+  energies.length = length_energy(x, want_gradient);
+  energies.angular = angular_energy(x, want_gradient);
+  const bool with_barrier =
+      options_.barrier_stiffness * options_.stiffness > 0.0 && !barrier_.empty();
+  if (with_barrier) {
+    energies.barrier = barrier_energy(x, normals, want_gradient);
+  }
+  if (want_gradient) {
+    gather_gradient(with_barrier, *gradient);
+  }
+  return energies;
+}
+
+// Normal springs, eq. 13: E = C (|d| - sigma k)^2, dE/dx_j = 2C (|d| - sigma k) d/|d| (eq. 14 up to
+// the factor 2, see the header); the forces go to spring_force_.
+double SpringSystem::length_energy(const Eigen::Matrix3Xd& x, bool want_gradient) const {
+  const std::vector<Spring>& springs = grid_->springs;
+  const double C = options_.stiffness;
+  const double sigma = options_.rest_scale;
+  return tbb::parallel_deterministic_reduce(
       tbb::blocked_range<std::size_t>(0, springs.size(), kGrain), 0.0,
       [&](const tbb::blocked_range<std::size_t>& range, double sum) {
         for (std::size_t s = range.begin(); s != range.end(); ++s) {
@@ -285,10 +296,16 @@ SpringEnergies SpringSystem::evaluate(const Eigen::Matrix3Xd& x, Eigen::Matrix3X
         return sum;
       },
       std::plus<double>());
+}
 
-  // Angular springs: E = C_a (|e| - sigma r)^2 with e = x_i - (x_a + x_b)/2; dE/dx_i = 2 C_a (|e| -
-  // sigma r) e/|e|, and de/dx_a = de/dx_b = -I/2 gives the half-magnitude reactions.
-  energies.angular = tbb::parallel_deterministic_reduce(
+// Angular springs: E = C_a (|e| - sigma r)^2 with e = x_i - (x_a + x_b)/2; dE/dx_i = 2 C_a (|e| -
+// sigma r) e/|e|, and de/dx_a = de/dx_b = -I/2 gives the half-magnitude reactions; the forces go
+// to angular_force_.
+double SpringSystem::angular_energy(const Eigen::Matrix3Xd& x, bool want_gradient) const {
+  const std::vector<AngularSpring>& angular = grid_->angular_springs;
+  const double Ca = options_.angular_stiffness;
+  const double sigma = options_.rest_scale;
+  return tbb::parallel_deterministic_reduce(
       tbb::blocked_range<std::size_t>(0, angular.size(), kGrain), 0.0,
       [&](const tbb::blocked_range<std::size_t>& range, double sum) {
         for (std::size_t c = range.begin(); c != range.end(); ++c) {
@@ -309,116 +326,117 @@ SpringEnergies SpringSystem::evaluate(const Eigen::Matrix3Xd& x, Eigen::Matrix3X
         return sum;
       },
       std::plus<double>());
+}
 
-  // Injectivity barrier (header): mu C w A h(g), g = sigma^2 tr(B G) det(S^T S) / D with
-  // G = T^T T the target Gram matrix and D = det(G) = |c|^2, c = T0 x T1 (Lagrange's identity;
-  // the cross product keeps a sliver's D accurate where G00 G11 - G01^2 would cancel to
-  // round-off), or with normals D = (c . n)^2, the area seen along the apex normal n (header).
-  // With q = sigma^2 det(S^T S), a = tr(B G) and m = c (or (c . n) n):
-  //   dg/dT = q (da/dT / D - a dD/dT / D^2),
-  //   da/dT0 = 2 (b00 T0 + b01 T1),   da/dT1 = 2 (b11 T1 + b01 T0),
-  //   dD/dT0 = 2 T1 x m,              dD/dT1 = 2 m x T0.
-  // A collapsed (or, with normals, inverted) target triangle has infinite energy: the line search
-  // backs off.
-  const double mu = options_.barrier_stiffness * C;
-  if (mu > 0.0 && !barrier_.empty()) {
-    if (normals != nullptr && normals->cols() != num_particles_) {
-      throw InvalidInputError("particle normals", "expected " + std::to_string(num_particles_) +
-                                                      " columns, got " +
-                                                      std::to_string(normals->cols()));
-    }
-    const double g0 = 1.0 / (options_.barrier_sigma * options_.barrier_sigma);
-    energies.barrier = tbb::parallel_deterministic_reduce(
-        tbb::blocked_range<std::size_t>(0, barrier_.size(), kGrain), 0.0,
-        [&](const tbb::blocked_range<std::size_t>& range, double sum) {
-          for (std::size_t t = range.begin(); t != range.end(); ++t) {
-            const BarrierTriangle& b = barrier_[t];
-            const auto col = 3 * static_cast<Eigen::Index>(t);
-            if (want_gradient) {
-              barrier_force_.middleCols<3>(col).setZero();
-            }
-            if (!barrier_active_[t]) {
-              continue;
-            }
-            const Eigen::Vector3d t0 = x.col(b.next) - x.col(b.i);
-            const Eigen::Vector3d t1 = x.col(b.prev) - x.col(b.i);
-            const Eigen::Vector3d c = t0.cross(t1);
-            Eigen::Vector3d m = c;
-            if (normals != nullptr) {
-              const Eigen::Vector3d n = normals->col(b.i);
-              const double seen = c.dot(n);
-              if (!(seen > 0.0)) {
-                sum += std::numeric_limits<double>::infinity();
-                continue;
-              }
-              m = seen * n;
-            }
-            const double D = m.squaredNorm();
-            if (!(D > 0.0)) {
+// Injectivity barrier (header): mu C w A h(g), g = sigma^2 tr(B G) det(S^T S) / D with
+// G = T^T T the target Gram matrix and D = det(G) = |c|^2, c = T0 x T1 (Lagrange's identity;
+// the cross product keeps a sliver's D accurate where G00 G11 - G01^2 would cancel to
+// round-off), or with normals D = (c . n)^2, the area seen along the apex normal n (header).
+// With q = sigma^2 det(S^T S), a = tr(B G) and m = c (or (c . n) n):
+//   dg/dT = q (da/dT / D - a dD/dT / D^2),
+//   da/dT0 = 2 (b00 T0 + b01 T1),   da/dT1 = 2 (b11 T1 + b01 T0),
+//   dD/dT0 = 2 T1 x m,              dD/dT1 = 2 m x T0.
+// A collapsed (or, with normals, inverted) target triangle has infinite energy: the line search
+// backs off.
+double SpringSystem::barrier_energy(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd* normals,
+                                    bool want_gradient) const {
+  const double mu = options_.barrier_stiffness * options_.stiffness;
+  const double sigma = options_.rest_scale;
+  if (normals != nullptr && normals->cols() != num_particles_) {
+    throw InvalidInputError("particle normals", "expected " + std::to_string(num_particles_) +
+                                                    " columns, got " +
+                                                    std::to_string(normals->cols()));
+  }
+  const double g0 = 1.0 / (options_.barrier_sigma * options_.barrier_sigma);
+  return tbb::parallel_deterministic_reduce(
+      tbb::blocked_range<std::size_t>(0, barrier_.size(), kGrain), 0.0,
+      [&](const tbb::blocked_range<std::size_t>& range, double sum) {
+        for (std::size_t t = range.begin(); t != range.end(); ++t) {
+          const BarrierTriangle& b = barrier_[t];
+          const auto col = 3 * static_cast<Eigen::Index>(t);
+          if (want_gradient) {
+            barrier_force_.middleCols<3>(col).setZero();
+          }
+          if (!barrier_active_[t]) {
+            continue;
+          }
+          const Eigen::Vector3d t0 = x.col(b.next) - x.col(b.i);
+          const Eigen::Vector3d t1 = x.col(b.prev) - x.col(b.i);
+          const Eigen::Vector3d c = t0.cross(t1);
+          Eigen::Vector3d m = c;
+          if (normals != nullptr) {
+            const Eigen::Vector3d n = normals->col(b.i);
+            const double seen = c.dot(n);
+            if (!(seen > 0.0)) {
               sum += std::numeric_limits<double>::infinity();
               continue;
             }
-            const double a =
-                b.b00 * t0.squaredNorm() + 2.0 * b.b01 * t0.dot(t1) + b.b11 * t1.squaredNorm();
-            const double q = sigma * sigma * b.source_det;
-            const double g = q * a / D;
-            if (!(g > g0)) {
-              continue;
-            }
-            const double r = g / g0 - 1.0;
-            sum += mu * b.weight * r * r * r;
-            if (want_gradient) {
-              const double dh = mu * b.weight * 3.0 * r * r / g0 * q;  // dE/dg times q
-              const double over_d = 1.0 / D, a_over_d2 = a / (D * D);
-              // dE/dx_next and dE/dx_prev
-              const Eigen::Vector3d f0 =
-                  dh * (2.0 * over_d * (b.b00 * t0 + b.b01 * t1) - 2.0 * a_over_d2 * t1.cross(m));
-              const Eigen::Vector3d f1 =
-                  dh * (2.0 * over_d * (b.b11 * t1 + b.b01 * t0) - 2.0 * a_over_d2 * m.cross(t0));
-              barrier_force_.col(col) = -(f0 + f1);
-              barrier_force_.col(col + 1) = f0;
-              barrier_force_.col(col + 2) = f1;
-            }
+            m = seen * n;
           }
-          return sum;
-        },
-        std::plus<double>());
-  }
-  const bool with_barrier = mu > 0.0 && !barrier_.empty();
+          const double D = m.squaredNorm();
+          if (!(D > 0.0)) {
+            sum += std::numeric_limits<double>::infinity();
+            continue;
+          }
+          const double a =
+              b.b00 * t0.squaredNorm() + 2.0 * b.b01 * t0.dot(t1) + b.b11 * t1.squaredNorm();
+          const double q = sigma * sigma * b.source_det;
+          const double g = q * a / D;
+          if (!(g > g0)) {
+            continue;
+          }
+          const double r = g / g0 - 1.0;
+          sum += mu * b.weight * r * r * r;
+          if (want_gradient) {
+            const double dh = mu * b.weight * 3.0 * r * r / g0 * q;  // dE/dg times q
+            const double over_d = 1.0 / D, a_over_d2 = a / (D * D);
+            // dE/dx_next and dE/dx_prev
+            const Eigen::Vector3d f0 =
+                dh * (2.0 * over_d * (b.b00 * t0 + b.b01 * t1) - 2.0 * a_over_d2 * t1.cross(m));
+            const Eigen::Vector3d f1 =
+                dh * (2.0 * over_d * (b.b11 * t1 + b.b01 * t0) - 2.0 * a_over_d2 * m.cross(t0));
+            barrier_force_.col(col) = -(f0 + f1);
+            barrier_force_.col(col + 1) = f0;
+            barrier_force_.col(col + 2) = f1;
+          }
+        }
+        return sum;
+      },
+      std::plus<double>());
+}
 
-  if (want_gradient) {
-    // Gather per particle in the fixed incidence order: no races, same bits for any thread count.
-    gradient->resize(3, num_particles_);
-    tbb::parallel_for(tbb::blocked_range<int>(0, num_particles_, static_cast<int>(kGrain)),
-                      [&](const tbb::blocked_range<int>& range) {
-                        for (int p = range.begin(); p != range.end(); ++p) {
-                          Eigen::Vector3d g = Eigen::Vector3d::Zero();
-                          for (int k = spring_offset_[p]; k < spring_offset_[p + 1]; ++k) {
-                            const int code = spring_entry_[k];
-                            if (code & 1) {
-                              g -= spring_force_.col(code >> 1);
-                            } else {
-                              g += spring_force_.col(code >> 1);
-                            }
+// Gathers the forces per particle in the fixed incidence order: no races, same bits for any thread
+// count.
+void SpringSystem::gather_gradient(bool with_barrier, Eigen::Matrix3Xd& gradient) const {
+  gradient.resize(3, num_particles_);
+  tbb::parallel_for(tbb::blocked_range<int>(0, num_particles_, static_cast<int>(kGrain)),
+                    [&](const tbb::blocked_range<int>& range) {
+                      for (int p = range.begin(); p != range.end(); ++p) {
+                        Eigen::Vector3d g = Eigen::Vector3d::Zero();
+                        for (int k = spring_offset_[p]; k < spring_offset_[p + 1]; ++k) {
+                          const int code = spring_entry_[k];
+                          if (code & 1) {
+                            g -= spring_force_.col(code >> 1);
+                          } else {
+                            g += spring_force_.col(code >> 1);
                           }
-                          for (int k = angular_offset_[p]; k < angular_offset_[p + 1]; ++k) {
-                            const int code = angular_entry_[k];
-                            if (code & 1) {
-                              g -= 0.5 * angular_force_.col(code >> 1);
-                            } else {
-                              g += angular_force_.col(code >> 1);
-                            }
-                          }
-                          if (with_barrier) {
-                            for (int k = barrier_offset_[p]; k < barrier_offset_[p + 1]; ++k) {
-                              g += barrier_force_.col(barrier_entry_[k]);
-                            }
-                          }
-                          gradient->col(p) = g;
                         }
-                      });
-  }
-  return energies;
+                        for (int k = angular_offset_[p]; k < angular_offset_[p + 1]; ++k) {
+                          const int code = angular_entry_[k];
+                          if (code & 1) {
+                            g -= 0.5 * angular_force_.col(code >> 1);
+                          } else {
+                            g += angular_force_.col(code >> 1);
+                          }
+                        }
+                        if (with_barrier) {
+                          for (int k = barrier_offset_[p]; k < barrier_offset_[p + 1]; ++k) {
+                            g += barrier_force_.col(barrier_entry_[k]);
+                          }
+                        }
+                        gradient.col(p) = g;
+                      }
+                    });
 }
 
 void SpringSystem::folded_corners(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& normals,

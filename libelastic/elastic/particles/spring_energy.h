@@ -160,6 +160,13 @@ class SpringSystem {
 
  private:
   void build_barrier(const ParticleGrid& grid);
+  // The three terms of evaluate(), each filling its force buffer when want_gradient, and the
+  // gather of those forces into the gradient.
+  double length_energy(const Eigen::Matrix3Xd& x, bool want_gradient) const;
+  double angular_energy(const Eigen::Matrix3Xd& x, bool want_gradient) const;
+  double barrier_energy(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd* normals,
+                        bool want_gradient) const;
+  void gather_gradient(bool with_barrier, Eigen::Matrix3Xd& gradient) const;
 
   const ParticleGrid* grid_ = nullptr;
   SpringEnergyOptions options_;

@@ -85,6 +85,86 @@ TriangleHit closest_on_triangle(const Eigen::Vector3d& p, const Eigen::Vector3d&
   return finish(vb / sum, vc / sum);  // face interior
 }
 
+// An Embree point query over the tessellation's triangles, in one of two modes: the nearest
+// triangle (limit < 0), or the collection of the candidates nearer than `limit`, the nearest few
+// kept.
+struct TriangleQuery {
+  const LimitTessellation* tessellation = nullptr;
+  double scale = 1.0;  // bounding-box diagonal (absolute slack for the BVH's float rounding)
+  Eigen::Vector3d x;
+  // Nearest-triangle mode.
+  TriangleHit best;
+  int best_triangle = -1;
+  // Collection mode.
+  double limit = -1.0;
+  std::array<std::pair<TriangleHit, int>, 16> candidates{};
+  int num_candidates = 0;
+
+  TriangleHit hit(int triangle) const {
+    const Eigen::Vector3i& tri = tessellation->triangles[static_cast<size_t>(triangle)];
+    return closest_on_triangle(x, tessellation->positions[static_cast<size_t>(tri[0])],
+                               tessellation->positions[static_cast<size_t>(tri[1])],
+                               tessellation->positions[static_cast<size_t>(tri[2])]);
+  }
+
+  // Embree's callback: true when it shrank the query radius.
+  static bool visit(RTCPointQueryFunctionArguments* args) {
+    TriangleQuery& q = *static_cast<TriangleQuery*>(args->userPtr);
+    const TriangleHit hit = q.hit(static_cast<int>(args->primID));
+    if (q.limit < 0.0) {
+      if (hit.dist2 >= q.best.dist2) {
+        return false;
+      }
+      q.best = hit;
+      q.best_triangle = static_cast<int>(args->primID);
+      // The BVH holds float vertices: keep a little slack so float rounding does not cull the
+      // triangle that is nearest in double.
+      const double radius = std::sqrt(hit.dist2) * (1.0 + 1e-5) + 1e-6 * q.scale;
+      args->query->radius = std::min(args->query->radius, static_cast<float>(radius) * 1.0001f);
+      return true;
+    }
+    if (hit.dist2 > q.limit * q.limit) {
+      return false;
+    }
+    const int capacity = static_cast<int>(q.candidates.size());
+    if (q.num_candidates < capacity) {
+      q.candidates[static_cast<size_t>(q.num_candidates++)] = {hit, static_cast<int>(args->primID)};
+    } else {
+      auto worst = std::max_element(
+          q.candidates.begin(), q.candidates.end(),
+          [](const auto& a, const auto& b) { return a.first.dist2 < b.first.dist2; });
+      if (hit.dist2 < worst->first.dist2) {
+        *worst = {hit, static_cast<int>(args->primID)};
+      }
+    }
+    return false;
+  }
+
+  // Visits the triangles within `radius` of x.
+  void run(RTCScene scene, float radius) {
+    RTCPointQuery point_query;
+    point_query.x = static_cast<float>(x.x());
+    point_query.y = static_cast<float>(x.y());
+    point_query.z = static_cast<float>(x.z());
+    point_query.time = 0.0f;
+    point_query.radius = radius;
+    RTCPointQueryContext context;
+    rtcInitPointQueryContext(&context);
+    rtcPointQuery(scene, &point_query, &context, &TriangleQuery::visit, this);
+  }
+
+  // The nearest triangle by a scan (only when the query point overflows float).
+  void scan() {
+    for (size_t k = 0; k < tessellation->triangles.size(); ++k) {
+      const TriangleHit h = hit(static_cast<int>(k));
+      if (h.dist2 < best.dist2) {
+        best = h;
+        best_triangle = static_cast<int>(k);
+      }
+    }
+  }
+};
+
 }  // namespace
 
 // ---------------------------------------------------------------------------------------------------
@@ -130,6 +210,7 @@ struct SurfaceProjector::Impl {
   }
   ClosestPoint finish(const Eigen::Vector3d& x, const detail::NewtonRun& run) const;
   ClosestPoint global(const Eigen::Vector3d& x) const;
+  void try_candidates(const TriangleQuery& query, detail::NewtonRun& best) const;
   ClosestPoint warm(const Eigen::Vector3d& x, const SurfacePoint& hint) const;
 };
 
@@ -369,77 +450,13 @@ ClosestPoint SurfaceProjector::Impl::finish(const Eigen::Vector3d& x,
 }
 
 ClosestPoint SurfaceProjector::Impl::global(const Eigen::Vector3d& x) const {
-  struct Query {
-    const Impl* impl;
-    Eigen::Vector3d x;
-    // Nearest-triangle mode.
-    TriangleHit best;
-    int best_triangle = -1;
-    // Collection mode (limit > 0): the candidates nearer than `limit`, the nearest few kept.
-    double limit = -1.0;
-    std::array<std::pair<TriangleHit, int>, 16> candidates{};
-    int num_candidates = 0;
-  };
-  Query query{this, x, {}, -1, -1.0, {}, 0};
-
-  auto callback = [](RTCPointQueryFunctionArguments* args) -> bool {
-    Query& q = *static_cast<Query*>(args->userPtr);
-    const LimitTessellation& t = q.impl->tessellation;
-    const Eigen::Vector3i& tri = t.triangles[args->primID];
-    const TriangleHit hit = closest_on_triangle(q.x, t.positions[static_cast<size_t>(tri[0])],
-                                                t.positions[static_cast<size_t>(tri[1])],
-                                                t.positions[static_cast<size_t>(tri[2])]);
-    if (q.limit < 0.0) {
-      if (hit.dist2 >= q.best.dist2) {
-        return false;
-      }
-      q.best = hit;
-      q.best_triangle = static_cast<int>(args->primID);
-      // The BVH holds float vertices: keep a little slack so float rounding does not cull the
-      // triangle that is nearest in double.
-      const double radius = std::sqrt(hit.dist2) * (1.0 + 1e-5) + 1e-6 * q.impl->scale;
-      args->query->radius = std::min(args->query->radius, static_cast<float>(radius) * 1.0001f);
-      return true;
-    }
-    if (hit.dist2 > q.limit * q.limit) {
-      return false;
-    }
-    const int capacity = static_cast<int>(q.candidates.size());
-    if (q.num_candidates < capacity) {
-      q.candidates[static_cast<size_t>(q.num_candidates++)] = {hit, static_cast<int>(args->primID)};
-    } else {
-      auto worst = std::max_element(
-          q.candidates.begin(), q.candidates.end(),
-          [](const auto& a, const auto& b) { return a.first.dist2 < b.first.dist2; });
-      if (hit.dist2 < worst->first.dist2) {
-        *worst = {hit, static_cast<int>(args->primID)};
-      }
-    }
-    return false;
-  };
-
-  RTCPointQuery point_query;
-  point_query.x = static_cast<float>(x.x());
-  point_query.y = static_cast<float>(x.y());
-  point_query.z = static_cast<float>(x.z());
-  point_query.time = 0.0f;
-  point_query.radius = std::numeric_limits<float>::infinity();
-  RTCPointQueryContext context;
-  rtcInitPointQueryContext(&context);
-  rtcPointQuery(scene->get(), &point_query, &context, callback, &query);
+  TriangleQuery query;
+  query.tessellation = &tessellation;
+  query.scale = scale;
+  query.x = x;
+  query.run(scene->get(), std::numeric_limits<float>::infinity());
   if (query.best_triangle < 0) {
-    // Only when the query point overflows float: fall back to a scan.
-    for (size_t k = 0; k < tessellation.triangles.size(); ++k) {
-      const Eigen::Vector3i& tri = tessellation.triangles[k];
-      const TriangleHit hit =
-          closest_on_triangle(x, tessellation.positions[static_cast<size_t>(tri[0])],
-                              tessellation.positions[static_cast<size_t>(tri[1])],
-                              tessellation.positions[static_cast<size_t>(tri[2])]);
-      if (hit.dist2 < query.best.dist2) {
-        query.best = hit;
-        query.best_triangle = static_cast<int>(k);
-      }
-    }
+    query.scan();
   }
   detail::NewtonRun best = newton(x, seed(query.best_triangle, query.best.w1, query.best.w2));
 
@@ -447,52 +464,58 @@ ClosestPoint SurfaceProjector::Impl::global(const Eigen::Vector3d& x) const {
   if (options.max_global_seeds > 1) {
     const double limit = std::sqrt(best.dist2) + tessellation_error;
     query.limit = limit;
-    point_query.radius = static_cast<float>(limit * (1.0 + 1e-5) + 1e-6 * scale) * 1.0001f;
-    rtcInitPointQueryContext(&context);
-    rtcPointQuery(scene->get(), &point_query, &context, callback, &query);
-    std::sort(query.candidates.begin(), query.candidates.begin() + query.num_candidates,
-              [](const auto& a, const auto& b) { return a.first.dist2 < b.first.dist2; });
-    std::array<Eigen::Vector3d, 16> tried;
-    int num_tried = 0;
-    tried[static_cast<size_t>(num_tried++)] = best.d.position;
-    int runs = 1;
-    for (int c = 0; c < query.num_candidates && runs < options.max_global_seeds; ++c) {
-      const auto& [hit, triangle] = query.candidates[static_cast<size_t>(c)];
-      if (triangle == query.best_triangle) {
-        continue;
-      }
-      // A triangle cannot hide a limit point nearer than its own distance minus eps.
-      const double lower = std::sqrt(hit.dist2) - tessellation_error;
-      if (lower * std::abs(lower) >= best.dist2) {
-        continue;
-      }
-      // Skip candidates within one triangle size of a Newton answer: they lie in its basin.
-      const Eigen::Vector3i& tri = tessellation.triangles[static_cast<size_t>(triangle)];
-      const Eigen::Vector3d& a = tessellation.positions[static_cast<size_t>(tri[0])];
-      const Eigen::Vector3d& b = tessellation.positions[static_cast<size_t>(tri[1])];
-      const Eigen::Vector3d& cc = tessellation.positions[static_cast<size_t>(tri[2])];
-      const Eigen::Vector3d foot = (1.0 - hit.w1 - hit.w2) * a + hit.w1 * b + hit.w2 * cc;
-      const double size2 =
-          std::max({(b - a).squaredNorm(), (cc - b).squaredNorm(), (a - cc).squaredNorm()});
-      bool near_tried = false;
-      for (int k = 0; k < num_tried; ++k) {
-        near_tried |= (tried[static_cast<size_t>(k)] - foot).squaredNorm() <= size2;
-      }
-      if (near_tried) {
-        continue;
-      }
-      detail::NewtonRun run = newton(x, seed(triangle, hit.w1, hit.w2));
-      ++runs;
-      if (num_tried < static_cast<int>(tried.size())) {
-        tried[static_cast<size_t>(num_tried++)] = run.d.position;
-      }
-      const bool better = run.converged == best.converged ? run.dist2 < best.dist2 : run.converged;
-      if (better) {
-        best = run;
-      }
-    }
+    query.run(scene->get(), static_cast<float>(limit * (1.0 + 1e-5) + 1e-6 * scale) * 1.0001f);
+    try_candidates(query, best);
   }
   return finish(x, best);
+}
+
+// Newton from the collected candidates, nearest first, up to max_global_seeds runs in all; `best`
+// becomes the best converged answer.
+void SurfaceProjector::Impl::try_candidates(const TriangleQuery& query,
+                                            detail::NewtonRun& best) const {
+  std::array<std::pair<TriangleHit, int>, 16> candidates = query.candidates;
+  std::sort(candidates.begin(), candidates.begin() + query.num_candidates,
+            [](const auto& a, const auto& b) { return a.first.dist2 < b.first.dist2; });
+  std::array<Eigen::Vector3d, 16> tried;
+  int num_tried = 0;
+  tried[static_cast<size_t>(num_tried++)] = best.d.position;
+  int runs = 1;
+  for (int c = 0; c < query.num_candidates && runs < options.max_global_seeds; ++c) {
+    const auto& [hit, triangle] = candidates[static_cast<size_t>(c)];
+    if (triangle == query.best_triangle) {
+      continue;
+    }
+    // A triangle cannot hide a limit point nearer than its own distance minus eps.
+    const double lower = std::sqrt(hit.dist2) - tessellation_error;
+    if (lower * std::abs(lower) >= best.dist2) {
+      continue;
+    }
+    // Skip candidates within one triangle size of a Newton answer: they lie in its basin.
+    const Eigen::Vector3i& tri = tessellation.triangles[static_cast<size_t>(triangle)];
+    const Eigen::Vector3d& a = tessellation.positions[static_cast<size_t>(tri[0])];
+    const Eigen::Vector3d& b = tessellation.positions[static_cast<size_t>(tri[1])];
+    const Eigen::Vector3d& cc = tessellation.positions[static_cast<size_t>(tri[2])];
+    const Eigen::Vector3d foot = (1.0 - hit.w1 - hit.w2) * a + hit.w1 * b + hit.w2 * cc;
+    const double size2 =
+        std::max({(b - a).squaredNorm(), (cc - b).squaredNorm(), (a - cc).squaredNorm()});
+    bool near_tried = false;
+    for (int k = 0; k < num_tried; ++k) {
+      near_tried |= (tried[static_cast<size_t>(k)] - foot).squaredNorm() <= size2;
+    }
+    if (near_tried) {
+      continue;
+    }
+    detail::NewtonRun run = newton(query.x, seed(triangle, hit.w1, hit.w2));
+    ++runs;
+    if (num_tried < static_cast<int>(tried.size())) {
+      tried[static_cast<size_t>(num_tried++)] = run.d.position;
+    }
+    const bool better = run.converged == best.converged ? run.dist2 < best.dist2 : run.converged;
+    if (better) {
+      best = run;
+    }
+  }
 }
 
 ClosestPoint SurfaceProjector::Impl::warm(const Eigen::Vector3d& x,

@@ -170,20 +170,16 @@ std::optional<std::vector<Eigen::Vector2d>> planar_coordinates(const Region& reg
   return uv;
 }
 
-/// Least-squares conformal map (Lévy et al. 2002), written as E_C = E_D - A (Desbrun et al. 2002;
-/// Mullen et al. 2008): the Dirichlet energy 1/2 sum_edges w_ij |U_i - U_j|^2 (cotangent weights
-/// w_ij = (cot a + cot b) / 2) minus the signed area of the image, 1/2 sum over boundary edges (i
-/// -> j, counter-clockwise) of (u_i v_j - u_j v_i). E_C >= 0 and vanishes exactly on conformal
-/// maps. Two boundary vertices (at the anchor and half the boundary length away) are pinned to
-/// remove the similarity freedom; the result is then scaled to the region's 3D area.
-RegionFlattening flatten_conformal(const Region& region) {
-  const int nv = region.num_vertices();
-  const std::string name = region_name(region);
+// The two pinned vertices of the conformal map: the boundary vertex nearest the anchor and the one
+// nearest half the boundary length away (another when they coincide), and their 3D distance.
+struct ConformalPins {
+  int first = 0, second = 0;
+  double distance = 0.0;
+};
+
+ConformalPins conformal_pins(const Region& region) {
   const SurfaceCurve curve = region.boundary_curve();
   const auto nb = static_cast<int>(region.boundary.size());
-  if (nb < 3) {
-    throw NumericalError(name, "flattening: the boundary has fewer than 3 vertices");
-  }
   const std::vector<double> cum = curve.arc_lengths();
   const double total = curve.length();
   auto nearest_vertex = [&](double s) {
@@ -200,23 +196,22 @@ RegionFlattening flatten_conformal(const Region& region) {
     }
     return region.boundary[static_cast<size_t>(best)];
   };
-  const int pin0 = nearest_vertex(region.anchor);
-  int pin1 = nearest_vertex(region.anchor + 0.5);
-  if (pin1 == pin0) {
-    pin1 = region.boundary[static_cast<size_t>(1)];
+  ConformalPins pins;
+  pins.first = nearest_vertex(region.anchor);
+  pins.second = nearest_vertex(region.anchor + 0.5);
+  if (pins.second == pins.first) {
+    pins.second = region.boundary[static_cast<size_t>(1)];
   }
-  const double pin_distance =
-      (region.positions[static_cast<size_t>(pin1)] - region.positions[static_cast<size_t>(pin0)])
-          .norm();
-  if (std::optional<std::vector<Eigen::Vector2d>> flat = planar_coordinates(region, pin0, pin1)) {
-    RegionFlattening out;
-    out.uv = std::move(*flat);
-    out.method = FlatteningMethod::Conformal;
-    out.folded_triangles = count_folds(region, out.uv);
-    return out;
-  }
+  pins.distance = (region.positions[static_cast<size_t>(pins.second)] -
+                   region.positions[static_cast<size_t>(pins.first)])
+                      .norm();
+  return pins;
+}
 
-  // Unknowns: u of every vertex then v of every vertex; the quadratic form is x^T Q x.
+// The quadratic form x^T Q x of E_C = E_D - A over x = (u of every vertex, then v of every vertex).
+Eigen::SparseMatrix<double> conformal_energy_form(const Region& region) {
+  const int nv = region.num_vertices();
+  const auto nb = static_cast<int>(region.boundary.size());
   Triplets q;
   for (const Eigen::Vector3i& t : region.triangles) {
     if (degenerate_in_3d(region, t)) {
@@ -271,13 +266,21 @@ RegionFlattening flatten_conformal(const Region& region) {
   const Eigen::Index unknowns = Eigen::Index{2} * nv;
   Eigen::SparseMatrix<double> full(unknowns, unknowns);
   full.setFromTriplets(q.begin(), q.end());
+  return full;
+}
+
+// Minimises x^T Q x with the first pin at (0, 0) and the second at (distance, 0).
+std::vector<Eigen::Vector2d> minimise_pinned(const Eigen::SparseMatrix<double>& full,
+                                             const ConformalPins& pins, const std::string& name) {
+  const auto unknowns = full.rows();
+  const auto nv = static_cast<int>(unknowns / 2);
   std::vector<int> index(static_cast<size_t>(unknowns), -1);
   Eigen::VectorXd fixed = Eigen::VectorXd::Zero(unknowns);
-  fixed[pin1] = pin_distance;  // pin0 at (0, 0), pin1 at (d, 0)
+  fixed[pins.second] = pins.distance;  // first pin at (0, 0), second at (d, 0)
   int free = 0;
   for (int r = 0; r < 2 * nv; ++r) {
     const int v = r % nv;
-    if (v != pin0 && v != pin1) {
+    if (v != pins.first && v != pins.second) {
       index[static_cast<size_t>(r)] = free++;
     }
   }
@@ -314,7 +317,11 @@ RegionFlattening flatten_conformal(const Region& region) {
           index[static_cast<size_t>(r)] >= 0 ? x[index[static_cast<size_t>(r)]] : fixed[r];
     }
   }
-  // Scale to the 3D area (the pin distance only fixes the scale approximately).
+  return uv;
+}
+
+// Scales uv to the region's 3D area (the pin distance only fixes the scale approximately).
+void scale_to_area(const Region& region, std::vector<Eigen::Vector2d>& uv) {
   double area2d = 0.0;
   for (const Eigen::Vector3i& t : region.triangles) {
     const Eigen::Vector2d e1 = uv[static_cast<size_t>(t[1])] - uv[static_cast<size_t>(t[0])];
@@ -327,9 +334,30 @@ RegionFlattening flatten_conformal(const Region& region) {
       p *= s;
     }
   }
+}
+
+/// Least-squares conformal map (Lévy et al. 2002), written as E_C = E_D - A (Desbrun et al. 2002;
+/// Mullen et al. 2008): the Dirichlet energy 1/2 sum_edges w_ij |U_i - U_j|^2 (cotangent weights
+/// w_ij = (cot a + cot b) / 2) minus the signed area of the image, 1/2 sum over boundary edges (i
+/// -> j, counter-clockwise) of (u_i v_j - u_j v_i). E_C >= 0 and vanishes exactly on conformal
+/// maps. Two boundary vertices (at the anchor and half the boundary length away) are pinned to
+/// remove the similarity freedom; the result is then scaled to the region's 3D area. A planar
+/// region is laid out in its own plane instead (the exact minimiser).
+RegionFlattening flatten_conformal(const Region& region) {
+  const std::string name = region_name(region);
+  if (region.boundary.size() < 3) {
+    throw NumericalError(name, "flattening: the boundary has fewer than 3 vertices");
+  }
+  const ConformalPins pins = conformal_pins(region);
   RegionFlattening out;
-  out.uv = std::move(uv);
   out.method = FlatteningMethod::Conformal;
+  if (std::optional<std::vector<Eigen::Vector2d>> flat =
+          planar_coordinates(region, pins.first, pins.second)) {
+    out.uv = std::move(*flat);
+  } else {
+    out.uv = minimise_pinned(conformal_energy_form(region), pins, name);
+    scale_to_area(region, out.uv);
+  }
   out.folded_triangles = count_folds(region, out.uv);
   return out;
 }

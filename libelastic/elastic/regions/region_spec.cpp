@@ -149,38 +149,15 @@ Region pick_disk_side(const CutMesh& cut, const std::string& name) {
   return regions_detail::make_region_from_patch(cut, comps[static_cast<size_t>(best)], best_topo);
 }
 
-Region disk_region(const Context& ctx, const RegionSpec& spec) {
-  const std::string& name = ctx.options.name;
-  if (!(spec.radius > 0.0) || !std::isfinite(spec.radius)) {
-    throw InvalidInputError(name,
-                            "disk radius " + std::to_string(spec.radius) + " must be positive");
-  }
-  const MeshLocation centre =
-      ctx.project(spec.center, "disk centre", [&](const Eigen::Vector3d& q) {
-        std::ostringstream text;
-        text.precision(6);
-        text << "disk:" << q.x() << ',' << q.y() << ',' << q.z() << ',' << spec.radius;
-        return text.str();
-      });
-  // Vertices beyond the disk's reach get a distance of 4 R: outside, far from the level set.
-  const Eigen::VectorXd distance = regions_detail::local_geodesic_distance(
-      ctx.tess.positions, ctx.tess.triangles, centre, spec.radius, 4.0 * spec.radius, name);
-  CutMesh cut = ctx.cut_mesh();
-  // Level set phi = distance - R, cut exactly: every edge whose ends have opposite signs is split
-  // where the linear interpolant vanishes. Crossings within kSnap of an end move to that end (phi
-  // := 0 there).
-  std::vector<double> phi(distance.data(), distance.data() + distance.size());
-  for (double& p : phi) {
-    p -= spec.radius;
-  }
-  const std::vector<double> raw = phi;
+// The tessellation's edges once each (a < b; boundary edges, which appear once, in their one
+// direction), sorted.
+std::vector<std::pair<int, int>> tessellation_edges(const Context& ctx, const CutMesh& cut) {
   std::vector<std::pair<int, int>> edges;
   for (const Eigen::Vector3i& t : ctx.tess.triangles) {
     for (int k = 0; k < 3; ++k) {
       const int a = t[k], b = t[(k + 1) % 3];
       if (a < b) {
         edges.emplace_back(a, b);
-        // Boundary edges appear once, in one direction only.
       } else if (cut.edge_triangles(a, b).size() == 1) {
         edges.emplace_back(b, a);
       }
@@ -188,10 +165,21 @@ Region disk_region(const Context& ctx, const RegionSpec& spec) {
   }
   std::sort(edges.begin(), edges.end());
   edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
+  return edges;
+}
+
+// Cuts the level set phi = 0 exactly: every edge whose ends have opposite signs is split where the
+// linear interpolant vanishes. Crossings within kSnap of an end move to that end (phi := 0 there).
+// phi gains a zero per new vertex.
+void cut_zero_level(const std::vector<std::pair<int, int>>& edges, CutMesh& cut,
+                    std::vector<double>& phi) {
+  const auto crosses = [](double pa, double pb) {
+    return (pa < 0.0 && pb > 0.0) || (pa > 0.0 && pb < 0.0);
+  };
   std::vector<char> zero(phi.size(), 0);
   for (const auto& [a, b] : edges) {
     const double pa = phi[static_cast<size_t>(a)], pb = phi[static_cast<size_t>(b)];
-    if (!((pa < 0.0 && pb > 0.0) || (pa > 0.0 && pb < 0.0))) {
+    if (!crosses(pa, pb)) {
       continue;
     }
     const double t = pa / (pa - pb);
@@ -209,14 +197,18 @@ Region disk_region(const Context& ctx, const RegionSpec& spec) {
   }
   for (const auto& [a, b] : edges) {
     const double pa = phi[static_cast<size_t>(a)], pb = phi[static_cast<size_t>(b)];
-    if (!((pa < 0.0 && pb > 0.0) || (pa > 0.0 && pb < 0.0))) {
+    if (!crosses(pa, pb)) {
       continue;
     }
     cut.split_edge(a, b, pa / (pa - pb));
     phi.push_back(0.0);
   }
-  // Every triangle is now on one side: inside when no corner is positive (all-zero triangles, on
-  // the level set itself, go by the unsnapped field).
+}
+
+// Per triangle of the cut mesh (each now on one side): inside when no corner is positive;
+// all-zero triangles, on the level set itself, go by the unsnapped field `raw`.
+std::vector<char> below_zero_level(const CutMesh& cut, const std::vector<double>& phi,
+                                   const std::vector<double>& raw) {
   std::vector<char> inside(static_cast<size_t>(cut.num_triangles()), 0);
   for (int t = 0; t < cut.num_triangles(); ++t) {
     const Eigen::Vector3i& v = cut.triangles[static_cast<size_t>(t)];
@@ -236,30 +228,61 @@ Region disk_region(const Context& ctx, const RegionSpec& spec) {
       inside[static_cast<size_t>(t)] = any_negative || raw_sum < 0.0;
     }
   }
-  // The component of the sub-level set around the centre (the discrete field may have far-away
-  // dips).
-  const auto comps = cut.components(&inside);
-  int chosen = -1;
-  for (size_t c = 0; c < comps.size() && chosen < 0; ++c) {
+  return inside;
+}
+
+// The component of the sub-level set that holds the centre (the discrete field may have far-away
+// dips); refused when the disk is too small to hold a triangle of the cut there.
+int centre_component(const Context& ctx, const CutMesh& cut,
+                     const std::vector<std::vector<int>>& comps, const MeshLocation& centre,
+                     double radius) {
+  for (size_t c = 0; c < comps.size(); ++c) {
     for (int t : comps[c]) {
       if (cut.origin[static_cast<size_t>(t)] == centre.triangle) {
-        chosen = static_cast<int>(c);
-        break;
+        return static_cast<int>(c);
       }
     }
   }
-  if (chosen < 0) {
-    const Eigen::Vector3i& home = ctx.tess.triangles[static_cast<size_t>(centre.triangle)];
-    double edge_sum = 0.0;
-    for (int k = 0; k < 3; ++k) {
-      edge_sum += (ctx.tess.positions[static_cast<size_t>(home[(k + 1) % 3])] -
-                   ctx.tess.positions[static_cast<size_t>(home[k])])
-                      .norm();
-    }
-    throw InvalidInputError(name, "the disk of radius " + std::to_string(spec.radius) +
-                                      " is too small for the surface's tessellation (edges about " +
-                                      std::to_string(edge_sum / 3.0) + " long at the centre)");
+  const Eigen::Vector3i& home = ctx.tess.triangles[static_cast<size_t>(centre.triangle)];
+  double edge_sum = 0.0;
+  for (int k = 0; k < 3; ++k) {
+    edge_sum += (ctx.tess.positions[static_cast<size_t>(home[(k + 1) % 3])] -
+                 ctx.tess.positions[static_cast<size_t>(home[k])])
+                    .norm();
   }
+  throw InvalidInputError(ctx.options.name,
+                          "the disk of radius " + std::to_string(radius) +
+                              " is too small for the surface's tessellation (edges about " +
+                              std::to_string(edge_sum / 3.0) + " long at the centre)");
+}
+
+Region disk_region(const Context& ctx, const RegionSpec& spec) {
+  const std::string& name = ctx.options.name;
+  if (!(spec.radius > 0.0) || !std::isfinite(spec.radius)) {
+    throw InvalidInputError(name,
+                            "disk radius " + std::to_string(spec.radius) + " must be positive");
+  }
+  const MeshLocation centre =
+      ctx.project(spec.center, "disk centre", [&](const Eigen::Vector3d& q) {
+        std::ostringstream text;
+        text.precision(6);
+        text << "disk:" << q.x() << ',' << q.y() << ',' << q.z() << ',' << spec.radius;
+        return text.str();
+      });
+  // Vertices beyond the disk's reach get a distance of 4 R: outside, far from the level set.
+  const Eigen::VectorXd distance = regions_detail::local_geodesic_distance(
+      ctx.tess.positions, ctx.tess.triangles, centre, spec.radius, 4.0 * spec.radius, name);
+  CutMesh cut = ctx.cut_mesh();
+  // The level set phi = distance - R, cut exactly.
+  std::vector<double> phi(distance.data(), distance.data() + distance.size());
+  for (double& p : phi) {
+    p -= spec.radius;
+  }
+  const std::vector<double> raw = phi;
+  cut_zero_level(tessellation_edges(ctx, cut), cut, phi);
+  const std::vector<char> inside = below_zero_level(cut, phi, raw);
+  const auto comps = cut.components(&inside);
+  const int chosen = centre_component(ctx, cut, comps, centre, spec.radius);
   PatchTopology topo = regions_detail::patch_topology(cut, comps[static_cast<size_t>(chosen)]);
   if (topo.loops.empty()) {
     throw InvalidInputError(name, "the disk of radius " + std::to_string(spec.radius) +

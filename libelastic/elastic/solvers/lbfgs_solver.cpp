@@ -11,6 +11,7 @@
 #include <deque>
 #include <functional>
 #include <limits>
+#include <optional>
 
 #include "elastic/core/error.h"
 #include "elastic/core/huge_pages.h"
@@ -130,81 +131,84 @@ struct Pair {
   double rho = 0.0;  // 1 / (s . y)
 };
 
-}  // namespace
-
-RelaxationResult relax_lbfgs(const RelaxationProblem& problem, const RelaxationOptions& options) {
-  const long long start = solver_detail::now_ticks();
-  RelaxationSetup setup(problem, options);
-  const LbfgsOptions& lb = options.lbfgs;
-  if (lb.memory < 0 || lb.max_backtracks < 1 || !(lb.armijo > 0.0 && lb.armijo < 1.0)) {
-    throw InvalidInputError("relaxation", "L-BFGS options out of range");
-  }
-
-  RelaxationResult result;
-  result.solver = SolverKind::Fast;
-  const long max_iterations = options.max_iterations > 0 ? options.max_iterations : 2000;
-  const Eigen::Index n = setup.num_free();
-  const Eigen::Index m = 3 * n;
-  const InteriorLayout layout{&setup, n};
-
-  Eigen::Matrix3Xd gradient;
-  resize_huge(gradient, 3, setup.num_particles);
-  SpringEnergies energies = setup.springs.evaluate(setup.positions, &gradient, &setup.normals);
-  result.initial_energy = energies.total();
-  result.evaluations = 1;
-  result.initial_folded_faces = setup.springs.folded_faces(setup.positions, setup.normals);
-
-  if (n == 0) {
-    result.reason = StopReason::NoFreeParticles;
-    result.setup_seconds = solver_detail::seconds_since(start);
-    solver_detail::finish_result(setup, problem, 0.0, result);
-    return result;
-  }
-
-  // H0 = L^-1, L the interior spring Laplacian: factorised once in nested-dissection order, or
-  // approximated by a multigrid V-cycle on large grids (LbfgsOptions::preconditioner).
-  const solver_detail::LaplacianInverse laplacian(solver_detail::interior_laplacian(setup, options),
-                                                  solver_detail::interior_coordinates(setup), lb);
-  result.preconditioner = laplacian.kind();
-
-  // Held particles (see the file comment of lbfgs_solver.h): interior particles that the line
-  // search stopped from folding a face. They stay where they are, like boundary particles, until a
-  // release; the solver works in the subspace of the others: the held rows of the tangential
-  // gradient, of H0 = L^-1 and of the direction are zero.
-  std::vector<char> held(static_cast<std::size_t>(n), 0);
-  Eigen::Index held_count = 0;
-  int releases = 0;
-  const auto is_held = [&](Eigen::Index i) { return held[static_cast<std::size_t>(i % n)] != 0; };
-  const auto mask = [&](Eigen::VectorXd& v) {
-    if (held_count == 0) {
-      return;
+// One call of relax_lbfgs: the state its iterations share and its steps (lbfgs_solver.h's list)
+// as named methods. run() reads as the algorithm: evaluate the start, prepare the preconditioner
+// and buffers, iterate (stop tests, direction, line search, step), report.
+class LbfgsRun {
+ public:
+  LbfgsRun(const RelaxationProblem& problem, const RelaxationOptions& options)
+      : problem_(problem), options_(options), lb_(options.lbfgs), setup_(problem, options) {
+    if (lb_.memory < 0 || lb_.max_backtracks < 1 || !(lb_.armijo > 0.0 && lb_.armijo < 1.0)) {
+      throw InvalidInputError("relaxation", "L-BFGS options out of range");
     }
-    for_chunks(m, [&](Eigen::Index i) {
-      if (is_held(i)) {
-        v[i] = 0.0;
+    result_.solver = SolverKind::Fast;
+  }
+  LbfgsRun(const LbfgsRun&) = delete;
+  LbfgsRun& operator=(const LbfgsRun&) = delete;
+
+  RelaxationResult run() {
+    evaluate_start();
+    if (n_ == 0) {
+      result_.reason = StopReason::NoFreeParticles;
+      result_.setup_seconds = solver_detail::seconds_since(start_);
+      solver_detail::finish_result(setup_, problem_, 0.0, result_);
+      return std::move(result_);
+    }
+    prepare();
+    result_.setup_seconds = solver_detail::seconds_since(start_);
+    const long long solve_start = solver_detail::now_ticks();
+    iterate();
+    for (Eigen::Index k = 0; k < n_; ++k) {
+      if (held_[static_cast<std::size_t>(k)]) {
+        result_.held_particles.push_back(setup_.interior[static_cast<std::size_t>(k)]);
       }
-    });
-  };
-  // The norm of the rows that are not held.
-  const auto free_norm = [&](const Eigen::VectorXd& v) {
-    if (held_count == 0) {
-      return std::sqrt(dot(v, v));
     }
-    return std::sqrt(sum_chunks(m, [&](Eigen::Index i) { return is_held(i) ? 0.0 : v[i] * v[i]; }));
-  };
-  // out = masked L^-1 (masked v); v is masked in place.
-  Eigen::VectorXd solved;
-  resize_huge(solved, m, 1);
-  const auto apply_h0 = [&](Eigen::VectorXd& v) {
-    mask(v);
-    laplacian.solve3(v, solved);
-    v.swap(solved);
-    mask(v);
-  };
+    result_.iterations = iteration_;
+    result_.solve_seconds = solver_detail::seconds_since(solve_start);
+    solver_detail::finish_result(setup_, problem_, initial_norm_, result_);
+    return std::move(result_);
+  }
 
-  std::vector<char> folded;
-  setup.springs.folded_corners(setup.positions, setup.normals, folded);
-  const bool with_barrier = setup.springs.options().barrier_stiffness > 0.0;
+ private:
+  // The energy, gradient and folded faces of the starting map.
+  void evaluate_start() {
+    resize_huge(gradient_, 3, setup_.num_particles);
+    energies_ = setup_.springs.evaluate(setup_.positions, &gradient_, &setup_.normals);
+    result_.initial_energy = energies_.total();
+    result_.evaluations = 1;
+    result_.initial_folded_faces = setup_.springs.folded_faces(setup_.positions, setup_.normals);
+  }
+
+  // H0, the round-off model, the solver's vectors, the tangential gradient and its reference norm,
+  // the tangent frames and the trial state.
+  void prepare() {
+    // H0 = L^-1, L the interior spring Laplacian: factorised once in nested-dissection order, or
+    // approximated by a multigrid V-cycle on large grids (LbfgsOptions::preconditioner).
+    laplacian_.emplace(solver_detail::interior_laplacian(setup_, options_),
+                       solver_detail::interior_coordinates(setup_), lb_);
+    result_.preconditioner = laplacian_->kind();
+    held_.assign(static_cast<std::size_t>(n_), 0);
+    resize_huge(solved_, m_, 1);
+    setup_.springs.folded_corners(setup_.positions, setup_.normals, folded_);
+    with_barrier_ = setup_.springs.options().barrier_stiffness > 0.0;
+    noise_factor_ = energy_noise_factor();
+
+    // The solver's vectors, allocated once (see core/huge_pages.h for why that matters at scale).
+    for (Eigen::VectorXd* v : {&q_, &q_free_, &direction_, &trial_q_}) {
+      resize_huge(*v, m_, 1);
+    }
+    layout_.tangential(gradient_, setup_.normals, setup_.curve_tangent, q_);
+    q_norm_ = std::sqrt(dot(q_, q_));
+    // The relative stopping test is scaled by the springs' own initial gradient: near-collapsed
+    // triangles of the start can make the barrier's share of the first gradient orders of
+    // magnitude larger, and a tolerance relative to that would stop far from the minimum.
+    const double spring_norm =
+        with_barrier_ ? solver_detail::spring_gradient_norm(setup_) : q_norm_;
+    initial_norm_ = problem_.reference_gradient_norm > 0.0 ? problem_.reference_gradient_norm
+                    : spring_norm > 0.0                    ? spring_norm
+                                                           : q_norm_;
+    prepare_trial_state();
+  }
 
   // Round-off of an energy evaluation. Each term C (|d| - k)^2 carries an error of about
   // 2 C |e| delta, e = |d| - k, delta the error of |d|: a few ulps of the coordinates, i.e.
@@ -212,244 +216,243 @@ RelaxationResult relax_lbfgs(const RelaxationProblem& problem, const RelaxationO
   // Cauchy-Schwarz: 2 eps (1 + extent / k) sqrt(E S), S = sum C k^2 over all springs. Near a
   // perfect map (E -> 0) this floor falls only like sqrt(E), far slower than E, and line-search
   // trials that differ from E by less than it are decided on the gradient instead.
-  double rest_sum = 0.0;
-  for (const Spring& spring : setup.grid.springs) {
-    rest_sum += options.stiffness * spring.rest * spring.rest;
-  }
-  for (const AngularSpring& spring : setup.grid.angular_springs) {
-    rest_sum += angular_stiffness(options) * spring.rest * spring.rest;
-  }
-  rest_sum *= problem.rest_scale * problem.rest_scale;
-  const double extent = setup.positions.cwiseAbs().maxCoeff();
-  const double noise_factor = 8.0 * std::numeric_limits<double>::epsilon() *
-                              (1.0 + extent / std::max(setup.mean_rest, 1e-300)) *
-                              std::sqrt(rest_sum);
-  const auto round_off = [&](double energy) {
-    return std::max(1e-13 * energy, noise_factor * std::sqrt(std::max(energy, 0.0)));
-  };
-
-  // The solver's vectors, allocated once (see core/huge_pages.h for why that matters at scale).
-  Eigen::VectorXd q, q_free, direction, trial_q;
-  for (Eigen::VectorXd* v : {&q, &q_free, &direction, &trial_q}) {
-    resize_huge(*v, m, 1);
-  }
-  layout.tangential(gradient, setup.normals, setup.curve_tangent, q);
-  double q_norm = std::sqrt(dot(q, q));
-  // The relative stopping test is scaled by the springs' own initial gradient: near-collapsed
-  // triangles of the start can make the barrier's share of the first gradient orders of magnitude
-  // larger, and a tolerance relative to that would stop far from the minimum.
-  const double spring_norm = with_barrier ? solver_detail::spring_gradient_norm(setup) : q_norm;
-  const double initial_norm = problem.reference_gradient_norm > 0.0
-                                  ? problem.reference_gradient_norm
-                              : spring_norm > 0.0 ? spring_norm
-                                                  : q_norm;
-  result.setup_seconds = solver_detail::seconds_since(start);
-  const long long solve_start = solver_detail::now_ticks();
-
-  std::deque<Pair> memory;
-  Pair next;        // storage of the next (s, y) pair; the oldest pair's once the memory is full
-  int stalled = 0;  // consecutive steps that changed the energy by less than its round-off
-  // Tangent frames (du, dv) of the interior particles at their current and trial surface points.
-  std::vector<SurfaceDerivatives> frames, trial_frames;
-  assign_huge(frames, static_cast<std::size_t>(n));
-  assign_huge(trial_frames, static_cast<std::size_t>(n));
-  for_chunks(
-      n,
-      [&](Eigen::Index k) {
-        frames[static_cast<std::size_t>(k)] = solver_detail::tangent_frame(
-            setup.target.surface(),
-            setup.points[static_cast<std::size_t>(setup.interior[static_cast<std::size_t>(k)])]);
-      },
-      kSurfaceChunk);
-  // The trial state. Boundary particles never move, so their columns are copied once here and stay
-  // equal in both buffers through the swaps; the retraction writes the interior columns.
-  Eigen::Matrix3Xd trial_positions, trial_normals, trial_gradient;
-  resize_huge(trial_positions, 3, setup.num_particles);
-  resize_huge(trial_normals, 3, setup.num_particles);
-  resize_huge(trial_gradient, 3, setup.num_particles);
-  trial_positions = setup.positions;
-  trial_normals = setup.normals;
-  std::vector<SurfacePoint> trial_points;
-  trial_points.reserve(setup.points.size());
-  advise_huge_pages(trial_points.data(), setup.points.size() * sizeof(SurfacePoint));
-  trial_points.assign(setup.points.begin(), setup.points.end());
-  std::vector<char> trial_folded;
-  // Sliding boundary: trial curve parameters, tangents and speeds.
-  Eigen::Matrix3Xd trial_tangents = setup.curve_tangent;
-  std::vector<double> trial_s = setup.curve_s, trial_speed = setup.curve_speed;
-
-  const auto emit_frame = [&](long iteration) {
-    if (options.frame && iteration % options.frame_interval == 0) {
-      options.frame({iteration, &setup.positions, energies.total(),
-                     initial_norm > 0.0 ? q_norm / initial_norm : 0.0});
+  double energy_noise_factor() const {
+    double rest_sum = 0.0;
+    for (const Spring& spring : setup_.grid.springs) {
+      rest_sum += options_.stiffness * spring.rest * spring.rest;
     }
-  };
-  emit_frame(0);
+    for (const AngularSpring& spring : setup_.grid.angular_springs) {
+      rest_sum += angular_stiffness(options_) * spring.rest * spring.rest;
+    }
+    rest_sum *= problem_.rest_scale * problem_.rest_scale;
+    const double extent = setup_.positions.cwiseAbs().maxCoeff();
+    return 8.0 * std::numeric_limits<double>::epsilon() *
+           (1.0 + extent / std::max(setup_.mean_rest, 1e-300)) * std::sqrt(rest_sum);
+  }
 
-  result.reason = StopReason::MaxIterations;
-  long iteration = 0;
-  for (;; ++iteration) {
-    if (q_norm <= options.relative_gradient_tolerance * initial_norm) {
-      result.reason = StopReason::RelativeGradient;
-      break;
-    }
-    if (q_norm <= setup.absolute_bound) {
-      result.reason = StopReason::AbsoluteGradient;
-      break;
-    }
-    q_free = q;
-    mask(q_free);
-    if (held_count > 0) {
-      const double norm = std::sqrt(dot(q_free, q_free));
-      if (norm <= options.relative_gradient_tolerance * initial_norm ||
-          norm <= setup.absolute_bound) {
-        // Every particle that is not held is at equilibrium. Release the held ones once: if the
-        // energy lets them move away from the fold, the solver goes on; if they are held again and
-        // the rest settles again, the minimum lies beyond the no-fold constraint.
-        if (releases >= kMaxReleases) {
-          result.reason = StopReason::FoldConstrained;
-          break;
+  double round_off(double energy) const {
+    return std::max(1e-13 * energy, noise_factor_ * std::sqrt(std::max(energy, 0.0)));
+  }
+
+  // Tangent frames (du, dv) of the interior particles, and the trial buffers. Boundary particles
+  // never move, so their columns are copied once here and stay equal in both buffers through the
+  // swaps; the retraction writes the interior columns.
+  void prepare_trial_state() {
+    assign_huge(frames_, static_cast<std::size_t>(n_));
+    assign_huge(trial_frames_, static_cast<std::size_t>(n_));
+    for_chunks(
+        n_,
+        [&](Eigen::Index k) {
+          frames_[static_cast<std::size_t>(k)] = solver_detail::tangent_frame(
+              setup_.target.surface(),
+              setup_
+                  .points[static_cast<std::size_t>(setup_.interior[static_cast<std::size_t>(k)])]);
+        },
+        kSurfaceChunk);
+    resize_huge(trial_positions_, 3, setup_.num_particles);
+    resize_huge(trial_normals_, 3, setup_.num_particles);
+    resize_huge(trial_gradient_, 3, setup_.num_particles);
+    trial_positions_ = setup_.positions;
+    trial_normals_ = setup_.normals;
+    trial_points_.reserve(setup_.points.size());
+    advise_huge_pages(trial_points_.data(), setup_.points.size() * sizeof(SurfacePoint));
+    trial_points_.assign(setup_.points.begin(), setup_.points.end());
+    // Sliding boundary: trial curve parameters, tangents and speeds.
+    trial_tangents_ = setup_.curve_tangent;
+    trial_s_ = setup_.curve_s;
+    trial_speed_ = setup_.curve_speed;
+  }
+
+  void iterate() {
+    emit_frame(0);
+    result_.reason = StopReason::MaxIterations;
+    for (iteration_ = 0;; ++iteration_) {
+      if (converged() || !free_gradient_or_release() || out_of_budget()) {
+        break;
+      }
+      choose_direction();
+      if (!line_search()) {
+        if (!memory_.empty()) {  // retry from the preconditioned gradient before giving up
+          memory_.clear();
+          continue;
         }
-        ++releases;
-        std::fill(held.begin(), held.end(), 0);
-        held_count = 0;
-        memory.clear();
-        q_free = q;
+        result_.reason = at_round_off_ ? StopReason::RoundOff : StopReason::LineSearchFailed;
+        break;
       }
+      take_trial();
+      emit_frame(iteration_ + 1);
     }
-    // At the energy's round-off floor no step can be told from another by the energy: stopped
-    // there with a small gradient the map is at its minimum to working precision (the barrier's
-    // stiffness can keep the last digits of the gradient from 1e-6 while the energy no longer
-    // changes in its 13th digit).
-    const bool at_round_off = q_norm <= options.round_off_gradient_tolerance * initial_norm;
-    if (stalled >= kMaxStalled) {
-      result.reason = at_round_off ? StopReason::RoundOff : StopReason::LineSearchFailed;
-      break;
-    }
-    if (iteration >= max_iterations) {
-      break;
-    }
-    if (!report_progress(options.progress, {.stage = "relax",
-                                            .iteration = iteration,
-                                            .total = max_iterations,
-                                            .energy = energies.total(),
-                                            .gradient = q_norm / initial_norm})) {
-      result.reason = StopReason::Cancelled;
-      break;
-    }
+  }
 
-    // Two-loop recursion with H0 = L^-1 (newest pair first, then back).
-    direction = q_free;
-    std::vector<double> alphas(memory.size());
-    for (std::size_t k = memory.size(); k-- > 0;) {
-      alphas[k] = memory[k].rho * dot(memory[k].s, direction);
-      axpy(-alphas[k], memory[k].y, direction);
+  void emit_frame(long iteration) const {
+    if (options_.frame && iteration % options_.frame_interval == 0) {
+      options_.frame({iteration, &setup_.positions, energies_.total(),
+                      initial_norm_ > 0.0 ? q_norm_ / initial_norm_ : 0.0});
     }
-    apply_h0(direction);
-    for (std::size_t k = 0; k < memory.size(); ++k) {
-      const double beta = memory[k].rho * dot(memory[k].y, direction);
-      axpy(alphas[k] - beta, memory[k].s, direction);
-    }
-    direction = -direction;
-    layout.project(direction, setup.normals, setup.curve_tangent);
-    double slope = dot(q_free, direction);
-    if (!(slope < 0.0)) {
-      memory.clear();
-      direction = q_free;
-      apply_h0(direction);
-      direction = -direction;
-      layout.project(direction, setup.normals, setup.curve_tangent);
-      slope = dot(q_free, direction);
-      if (!(slope < 0.0)) {  // L is SPD, so only round-off gets here: fall back to steepest descent
-        direction = -q_free;
-        slope = -dot(q_free, q_free);
-      }
-    }
+  }
 
-    // Backtracking line search along the retraction (solver_detail::parametric_retraction, the
-    // magnet where it declines).
-    const auto retract = [&](double alpha) {
-      for_chunks(
-          n,
-          [&](Eigen::Index k) {
-            const auto kk = static_cast<std::size_t>(k);
-            const auto p = static_cast<std::size_t>(setup.interior[kk]);
-            const auto col = static_cast<Eigen::Index>(p);
-            const Eigen::Vector3d step = alpha * layout.at(direction, k);
-            SurfaceDerivatives& frame = trial_frames[kk];
-            if (step.isZero(0.0)) {  // blocked (or converged) particle: exactly where it is
-              trial_points[p] = setup.points[p];
-              trial_positions.col(col) = setup.positions.col(col);
-              trial_normals.col(col) = setup.normals.col(col);
-              frame = frames[kk];
-              if (setup.sliding[kk] >= 0) {
-                const auto b = static_cast<std::size_t>(setup.sliding[kk]);
-                trial_s[b] = setup.curve_s[b];
-                trial_speed[b] = setup.curve_speed[b];
-                trial_tangents.col(col) = setup.curve_tangent.col(col);
-              }
-              return;
-            }
-            const int on_curve = setup.sliding[kk];
-            if (on_curve >= 0) {  // along the curve: ds = (t . step) / |dc/ds|
-              const auto b = static_cast<std::size_t>(on_curve);
-              trial_s[b] = setup.curve_s[b] + setup.curve_tangent.col(col).dot(step) /
-                                                  std::max(setup.curve_speed[b], 1e-300);
-              Eigen::Vector3d position, tangent;
-              setup.curve_frame(trial_s[b], trial_points[p], position, tangent, trial_speed[b]);
-              trial_positions.col(col) = position;
-              trial_tangents.col(col) = tangent;
-              const SurfaceDerivatives d = setup.target.surface().derivatives(trial_points[p]);
-              const Eigen::Vector3d normal = d.du.cross(d.dv);
-              trial_normals.col(col) = normal.norm() > 1e-300
-                                           ? Eigen::Vector3d(normal.normalized())
-                                           : Eigen::Vector3d(setup.normals.col(col));
-              return;
-            }
-            ClosestPoint out;
-            if (!solver_detail::parametric_retraction(setup.target.surface(), setup.points[p],
-                                                      setup.positions.col(col), frames[kk], step,
-                                                      out, frame)) {
-              // Magnet fallback: the closest point of x + alpha p, warm started.
-              out = setup.target.closest(Eigen::Vector3d(setup.positions.col(col) + step),
-                                         setup.points[p]);
-              frame = solver_detail::tangent_frame(setup.target.surface(), out.point);
-            }
-            trial_points[p] = out.point;
-            trial_positions.col(col) = out.position;
-            trial_normals.col(col) = out.normal;
-          },
-          kSurfaceChunk);
-    };
-    bool accepted = false;
-    bool trial_q_ready = false;
-    // The first trial moves no particle farther than kMaxStep rest lengths: a step far beyond
-    // the grid's own scale (the barrier's gradient near a collapsing triangle can be orders of
-    // magnitude above the springs') would only be halved back, after walking every particle
-    // across many ptex faces for each halving.
-    double alpha = 1.0;
-    {
-      const double longest = std::sqrt(tbb::parallel_deterministic_reduce(
-          tbb::blocked_range<Eigen::Index>(0, n, kChunk), 0.0,
-          [&](const tbb::blocked_range<Eigen::Index>& r, double best) {
-            for (Eigen::Index k = r.begin(); k != r.end(); ++k) {
-              best = std::max(best, layout.at(direction, k).squaredNorm());
-            }
-            return best;
-          },
-          [](double a, double b) { return std::max(a, b); }));
-      const double cap = kMaxStep * setup.mean_rest;
-      if (longest > cap && cap > 0.0) {
-        alpha = cap / longest;
+  // The gradient tests of relaxation.h.
+  bool converged() {
+    if (q_norm_ <= options_.relative_gradient_tolerance * initial_norm_) {
+      result_.reason = StopReason::RelativeGradient;
+      return true;
+    }
+    if (q_norm_ <= setup_.absolute_bound) {
+      result_.reason = StopReason::AbsoluteGradient;
+      return true;
+    }
+    return false;
+  }
+
+  // q_free = the rows of q that are not held. When those are at equilibrium the held particles are
+  // released once: if the energy lets them move away from the fold, the solver goes on; if they are
+  // held again and the rest settles again, the minimum lies beyond the no-fold constraint (false:
+  // stop, FoldConstrained).
+  bool free_gradient_or_release() {
+    q_free_ = q_;
+    mask(q_free_);
+    if (held_count_ == 0) {
+      return true;
+    }
+    const double norm = std::sqrt(dot(q_free_, q_free_));
+    if (norm > options_.relative_gradient_tolerance * initial_norm_ &&
+        norm > setup_.absolute_bound) {
+      return true;
+    }
+    if (releases_ >= kMaxReleases) {
+      result_.reason = StopReason::FoldConstrained;
+      return false;
+    }
+    ++releases_;
+    std::fill(held_.begin(), held_.end(), 0);
+    held_count_ = 0;
+    memory_.clear();
+    q_free_ = q_;
+    return true;
+  }
+
+  // Stalled steps, the iteration limit and cancellation. At the energy's round-off floor no step
+  // can be told from another by the energy: stopped there with a small gradient the map is at its
+  // minimum to working precision (the barrier's stiffness can keep the last digits of the gradient
+  // from 1e-6 while the energy no longer changes in its 13th digit).
+  bool out_of_budget() {
+    at_round_off_ = q_norm_ <= options_.round_off_gradient_tolerance * initial_norm_;
+    if (stalled_ >= kMaxStalled) {
+      result_.reason = at_round_off_ ? StopReason::RoundOff : StopReason::LineSearchFailed;
+      return true;
+    }
+    if (iteration_ >= max_iterations_) {
+      return true;
+    }
+    if (!report_progress(options_.progress, {.stage = "relax",
+                                             .iteration = iteration_,
+                                             .total = max_iterations_,
+                                             .energy = energies_.total(),
+                                             .gradient = q_norm_ / initial_norm_})) {
+      result_.reason = StopReason::Cancelled;
+      return true;
+    }
+    return false;
+  }
+
+  bool is_held(Eigen::Index i) const { return held_[static_cast<std::size_t>(i % n_)] != 0; }
+
+  // Zeroes the held rows of v.
+  void mask(Eigen::VectorXd& v) const {
+    if (held_count_ == 0) {
+      return;
+    }
+    for_chunks(m_, [&](Eigen::Index i) {
+      if (is_held(i)) {
+        v[i] = 0.0;
+      }
+    });
+  }
+
+  // The norm of the rows that are not held.
+  double free_norm(const Eigen::VectorXd& v) const {
+    if (held_count_ == 0) {
+      return std::sqrt(dot(v, v));
+    }
+    return std::sqrt(
+        sum_chunks(m_, [&](Eigen::Index i) { return is_held(i) ? 0.0 : v[i] * v[i]; }));
+  }
+
+  // v = masked L^-1 (masked v).
+  void apply_h0(Eigen::VectorXd& v) {
+    mask(v);
+    laplacian_->solve3(v, solved_);
+    v.swap(solved_);
+    mask(v);
+  }
+
+  // direction = -P H q_free by the two-loop recursion with H0 = L^-1 (newest pair first, then
+  // back); if that is no descent direction, -P L^-1 q_free with the memory cleared, and in the end
+  // (round-off only: L is SPD) steepest descent.
+  void choose_direction() {
+    direction_ = q_free_;
+    std::vector<double> alphas(memory_.size());
+    for (std::size_t k = memory_.size(); k-- > 0;) {
+      alphas[k] = memory_[k].rho * dot(memory_[k].s, direction_);
+      axpy(-alphas[k], memory_[k].y, direction_);
+    }
+    apply_h0(direction_);
+    for (std::size_t k = 0; k < memory_.size(); ++k) {
+      const double beta = memory_[k].rho * dot(memory_[k].y, direction_);
+      axpy(alphas[k] - beta, memory_[k].s, direction_);
+    }
+    direction_ = -direction_;
+    layout_.project(direction_, setup_.normals, setup_.curve_tangent);
+    slope_ = dot(q_free_, direction_);
+    if (!(slope_ < 0.0)) {
+      preconditioned_gradient_direction();
+      if (!(slope_ < 0.0)) {
+        direction_ = -q_free_;
+        slope_ = -dot(q_free_, q_free_);
       }
     }
-    SpringEnergies trial_energies;
+  }
+
+  // direction = -P L^-1 q_free, the memory cleared (its pairs may mix held and free rows). It is a
+  // descent direction since the masked L^-1 is positive semi-definite and positive on the free
+  // rows.
+  void preconditioned_gradient_direction() {
+    memory_.clear();
+    direction_ = q_free_;
+    apply_h0(direction_);
+    direction_ = -direction_;
+    layout_.project(direction_, setup_.normals, setup_.curve_tangent);
+    slope_ = dot(q_free_, direction_);
+  }
+
+  // The first trial moves no particle farther than kMaxStep rest lengths: a step far beyond the
+  // grid's own scale (the barrier's gradient near a collapsing triangle can be orders of magnitude
+  // above the springs') would only be halved back, after walking every particle across many ptex
+  // faces for each halving.
+  double first_step() const {
+    const double longest = std::sqrt(tbb::parallel_deterministic_reduce(
+        tbb::blocked_range<Eigen::Index>(0, n_, kChunk), 0.0,
+        [&](const tbb::blocked_range<Eigen::Index>& r, double best) {
+          for (Eigen::Index k = r.begin(); k != r.end(); ++k) {
+            best = std::max(best, layout_.at(direction_, k).squaredNorm());
+          }
+          return best;
+        },
+        [](double a, double b) { return std::max(a, b); }));
+    const double cap = kMaxStep * setup_.mean_rest;
+    return longest > cap && cap > 0.0 ? cap / longest : 1.0;
+  }
+
+  // Backtracking line search along the retraction. True when a trial is accepted (the trial state
+  // holds it).
+  bool line_search() {
+    double alpha = first_step();
     int backtracks = 0, block_rounds = 0, fold_halvings = 0;
-    while (backtracks < lb.max_backtracks && slope < 0.0) {
-      trial_q_ready = false;
+    while (backtracks < lb_.max_backtracks && slope_ < 0.0) {
+      trial_q_ready_ = false;
       retract(alpha);
-      setup.springs.folded_corners(trial_positions, trial_normals, trial_folded);
-      if (setup.slide && !solver_detail::RelaxationSetup::in_order(trial_s)) {
+      setup_.springs.folded_corners(trial_positions_, trial_normals_, trial_folded_);
+      if (setup_.slide && !solver_detail::RelaxationSetup::in_order(trial_s_)) {
         // A boundary particle would pass its neighbour on the curve: shorten the step.
         alpha *= 0.5;
         ++backtracks;
@@ -459,46 +462,15 @@ RelaxationResult relax_lbfgs(const RelaxationProblem& problem, const RelaxationO
       // With the injectivity barrier (EnergyKind::Robust) a short enough step never folds (the
       // energy grows without bound first), so folding trials are only shortened, never blocked.
       const bool block_now =
-          !with_barrier && fold_halvings >= kFoldHalvings && block_rounds < kMaxBlockRounds;
-      bool new_fold = false;
-      for (std::size_t c = 0; c < folded.size(); ++c) {
-        if (!trial_folded[c] || folded[c]) {
-          continue;
-        }
-        new_fold = true;
-        if (!block_now) {
-          break;
-        }
-        // Hold the free particles of the newly folded corner: they keep their position from now
-        // on (until a release).
-        const SpringSystem::Corner& corner = setup.springs.corners()[c];
-        for (const int p : {corner.i, corner.next, corner.prev}) {
-          const int k = setup.interior_index[static_cast<std::size_t>(p)];
-          if (k < 0 || held[static_cast<std::size_t>(k)]) {
-            continue;
-          }
-          held[static_cast<std::size_t>(k)] = 1;
-          ++held_count;
-          for (int d = 0; d < 3; ++d) {
-            direction[d * n + k] = 0.0;
-          }
-        }
-      }
-      if (new_fold) {
+          !with_barrier_ && fold_halvings >= kFoldHalvings && block_rounds < kMaxBlockRounds;
+      if (new_fold(block_now)) {
         if (block_now) {
           // Retry the same step length without the held particles. Zeroing rows of a descent
-          // direction need not leave a descent direction, so it is recomputed in the new subspace
-          // (memory cleared: its pairs mix held and free rows): -P L^-1 q_free, which is one since
-          // the masked L^-1 is positive semi-definite and positive on the free rows.
+          // direction need not leave a descent direction, so it is recomputed in the new subspace.
           ++block_rounds;
-          memory.clear();
-          q_free = q;
-          mask(q_free);
-          direction = q_free;
-          apply_h0(direction);
-          direction = -direction;
-          layout.project(direction, setup.normals, setup.curve_tangent);
-          slope = dot(q_free, direction);
+          q_free_ = q_;
+          mask(q_free_);
+          preconditioned_gradient_direction();
         } else {
           alpha *= 0.5;
           ++backtracks;
@@ -506,106 +478,262 @@ RelaxationResult relax_lbfgs(const RelaxationProblem& problem, const RelaxationO
         }
         continue;
       }
-      // The barrier sees each triangle along its apex normal (SpringSystem::evaluate): the current
-      // iterate's normals, held fixed through the line search, so that every trial and the slope
-      // belong to one function of the positions (with the trials' own normals, whose turning the
-      // gradient does not see, thin triangles made the Armijo test fail near the minimum).
-      trial_energies = setup.springs.evaluate(trial_positions, &trial_gradient, &setup.normals);
-      ++result.evaluations;
-      const double energy = energies.total();
-      const double trial_energy = trial_energies.total();
-      if (std::isfinite(trial_energy)) {
-        if (trial_energy <= energy + lb.armijo * alpha * slope) {
-          accepted = true;
-        } else if (trial_energy <= energy + round_off(energy)) {
-          // Within round-off of the current energy: accept on a smaller tangential gradient.
-          layout.tangential(trial_gradient, trial_normals, trial_tangents, trial_q);
-          trial_q_ready = true;
-          accepted = free_norm(trial_q) < std::sqrt(dot(q_free, q_free));
-        }
-      }
-      if (accepted) {
-        break;
+      if (acceptable(alpha)) {
+        return true;
       }
       alpha *= 0.5;
       ++backtracks;
     }
-    if (!accepted) {
-      if (!memory.empty()) {  // retry from the preconditioned gradient before giving up
-        memory.clear();
+    return false;
+  }
+
+  // True when the trial folds a corner that was not folded. With `hold`, the free particles of
+  // every such corner are held: they keep their position from now on (until a release) and their
+  // rows of the direction are zeroed.
+  bool new_fold(bool hold) {
+    bool found = false;
+    for (std::size_t c = 0; c < folded_.size(); ++c) {
+      if (!trial_folded_[c] || folded_[c]) {
         continue;
       }
-      result.reason = at_round_off ? StopReason::RoundOff : StopReason::LineSearchFailed;
-      break;
-    }
-
-    if (!trial_q_ready) {
-      layout.tangential(trial_gradient, trial_normals, trial_tangents, trial_q);
-    }
-    if (next.s.size() != m) {
-      resize_huge(next.s, m, 1);
-      resize_huge(next.y, m, 1);
-    }
-    for_chunks(n, [&](Eigen::Index k) {
-      const auto p = static_cast<Eigen::Index>(setup.interior[static_cast<std::size_t>(k)]);
-      const bool free = !held[static_cast<std::size_t>(k)];
-      for (int c = 0; c < 3; ++c) {
-        next.s[c * n + k] = trial_positions(c, p) - setup.positions(c, p);
-        // y = (free part of the new gradient) - (free part of the old one)
-        next.y[c * n + k] = free ? trial_q[c * n + k] - q_free[c * n + k] : 0.0;
+      found = true;
+      if (!hold) {
+        break;
       }
-    });
-    const double sy = dot(next.s, next.y);
-    if (sy > 1e-12 * std::sqrt(dot(next.s, next.s) * dot(next.y, next.y)) && lb.memory > 0) {
-      next.rho = 1.0 / sy;
-      memory.push_back(std::move(next));
-      next = Pair{};
-      if (memory.size() > static_cast<std::size_t>(lb.memory)) {
-        next = std::move(memory.front());
-        memory.pop_front();
+      const SpringSystem::Corner& corner = setup_.springs.corners()[c];
+      for (const int p : {corner.i, corner.next, corner.prev}) {
+        const int k = setup_.interior_index[static_cast<std::size_t>(p)];
+        if (k < 0 || held_[static_cast<std::size_t>(k)]) {
+          continue;
+        }
+        held_[static_cast<std::size_t>(k)] = 1;
+        ++held_count_;
+        for (int d = 0; d < 3; ++d) {
+          direction_[d * n_ + k] = 0.0;
+        }
       }
     }
+    return found;
+  }
 
-    setup.positions.swap(trial_positions);
-    setup.normals.swap(trial_normals);
-    if (setup.slide) {
-      setup.curve_s.swap(trial_s);
-      setup.curve_speed.swap(trial_speed);
-      setup.curve_tangent.swap(trial_tangents);
+  // Evaluates the trial: the Armijo condition, or within the energy's round-off a smaller
+  // tangential gradient. The barrier sees each triangle along its apex normal
+  // (SpringSystem::evaluate): the current iterate's normals, held fixed through the line search, so
+  // that every trial and the slope belong to one function of the positions (with the trials' own
+  // normals, whose turning the gradient does not see, thin triangles made the Armijo test fail near
+  // the minimum).
+  bool acceptable(double alpha) {
+    trial_energies_ = setup_.springs.evaluate(trial_positions_, &trial_gradient_, &setup_.normals);
+    ++result_.evaluations;
+    const double energy = energies_.total();
+    const double trial_energy = trial_energies_.total();
+    if (!std::isfinite(trial_energy)) {
+      return false;
+    }
+    if (trial_energy <= energy + lb_.armijo * alpha * slope_) {
+      return true;
+    }
+    if (trial_energy <= energy + round_off(energy)) {
+      layout_.tangential(trial_gradient_, trial_normals_, trial_tangents_, trial_q_);
+      trial_q_ready_ = true;
+      return free_norm(trial_q_) < std::sqrt(dot(q_free_, q_free_));
+    }
+    return false;
+  }
+
+  // The trial state at step alpha along the direction (solver_detail::parametric_retraction, the
+  // magnet where it declines; sliding boundary particles along their curve).
+  void retract(double alpha) {
+    for_chunks(
+        n_,
+        [&](Eigen::Index k) {
+          const Eigen::Vector3d step = alpha * layout_.at(direction_, k);
+          if (step.isZero(0.0)) {  // blocked (or converged) particle: exactly where it is
+            retract_unmoved(k);
+          } else if (setup_.sliding[static_cast<std::size_t>(k)] >= 0) {
+            retract_on_curve(k, step);
+          } else {
+            retract_on_surface(k, step);
+          }
+        },
+        kSurfaceChunk);
+  }
+
+  void retract_unmoved(Eigen::Index k) {
+    const auto kk = static_cast<std::size_t>(k);
+    const auto p = static_cast<std::size_t>(setup_.interior[kk]);
+    const auto col = static_cast<Eigen::Index>(p);
+    trial_points_[p] = setup_.points[p];
+    trial_positions_.col(col) = setup_.positions.col(col);
+    trial_normals_.col(col) = setup_.normals.col(col);
+    trial_frames_[kk] = frames_[kk];
+    if (setup_.sliding[kk] >= 0) {
+      const auto b = static_cast<std::size_t>(setup_.sliding[kk]);
+      trial_s_[b] = setup_.curve_s[b];
+      trial_speed_[b] = setup_.curve_speed[b];
+      trial_tangents_.col(col) = setup_.curve_tangent.col(col);
+    }
+  }
+
+  // Along the curve: ds = (t . step) / |dc/ds|.
+  void retract_on_curve(Eigen::Index k, const Eigen::Vector3d& step) {
+    const auto kk = static_cast<std::size_t>(k);
+    const auto p = static_cast<std::size_t>(setup_.interior[kk]);
+    const auto col = static_cast<Eigen::Index>(p);
+    const auto b = static_cast<std::size_t>(setup_.sliding[kk]);
+    trial_s_[b] = setup_.curve_s[b] +
+                  setup_.curve_tangent.col(col).dot(step) / std::max(setup_.curve_speed[b], 1e-300);
+    Eigen::Vector3d position, tangent;
+    setup_.curve_frame(trial_s_[b], trial_points_[p], position, tangent, trial_speed_[b]);
+    trial_positions_.col(col) = position;
+    trial_tangents_.col(col) = tangent;
+    const SurfaceDerivatives d = setup_.target.surface().derivatives(trial_points_[p]);
+    const Eigen::Vector3d normal = d.du.cross(d.dv);
+    trial_normals_.col(col) = normal.norm() > 1e-300 ? Eigen::Vector3d(normal.normalized())
+                                                     : Eigen::Vector3d(setup_.normals.col(col));
+  }
+
+  void retract_on_surface(Eigen::Index k, const Eigen::Vector3d& step) {
+    const auto kk = static_cast<std::size_t>(k);
+    const auto p = static_cast<std::size_t>(setup_.interior[kk]);
+    const auto col = static_cast<Eigen::Index>(p);
+    SurfaceDerivatives& frame = trial_frames_[kk];
+    ClosestPoint out;
+    if (!solver_detail::parametric_retraction(setup_.target.surface(), setup_.points[p],
+                                              setup_.positions.col(col), frames_[kk], step, out,
+                                              frame)) {
+      // Magnet fallback: the closest point of x + alpha p, warm started.
+      out = setup_.target.closest(Eigen::Vector3d(setup_.positions.col(col) + step),
+                                  setup_.points[p]);
+      frame = solver_detail::tangent_frame(setup_.target.surface(), out.point);
+    }
+    trial_points_[p] = out.point;
+    trial_positions_.col(col) = out.position;
+    trial_normals_.col(col) = out.normal;
+  }
+
+  // Moves to the accepted trial: the memory's new pair, the swaps, the stall count, and the
+  // barrier taken again with the new normals.
+  void take_trial() {
+    if (!trial_q_ready_) {
+      layout_.tangential(trial_gradient_, trial_normals_, trial_tangents_, trial_q_);
+    }
+    remember_step();
+    setup_.positions.swap(trial_positions_);
+    setup_.normals.swap(trial_normals_);
+    if (setup_.slide) {
+      setup_.curve_s.swap(trial_s_);
+      setup_.curve_speed.swap(trial_speed_);
+      setup_.curve_tangent.swap(trial_tangents_);
       // Entries that did not move keep their values in both buffers (the retraction copies them).
-      trial_s = setup.curve_s;
-      trial_speed = setup.curve_speed;
-      trial_tangents = setup.curve_tangent;
+      trial_s_ = setup_.curve_s;
+      trial_speed_ = setup_.curve_speed;
+      trial_tangents_ = setup_.curve_tangent;
     }
-    setup.points.swap(trial_points);
-    frames.swap(trial_frames);
-    folded.swap(trial_folded);
-    gradient.swap(trial_gradient);
-    stalled = energies.total() - trial_energies.total() <= 0.1 * round_off(energies.total())
-                  ? stalled + 1
-                  : 0;
-    energies = trial_energies;
-    if (energies.barrier > 0.0) {
+    setup_.points.swap(trial_points_);
+    frames_.swap(trial_frames_);
+    folded_.swap(trial_folded_);
+    gradient_.swap(trial_gradient_);
+    stalled_ = energies_.total() - trial_energies_.total() <= 0.1 * round_off(energies_.total())
+                   ? stalled_ + 1
+                   : 0;
+    energies_ = trial_energies_;
+    if (energies_.barrier > 0.0) {
       // At the accepted point the barrier is taken again with its own normals (nothing changes
       // where no triangle is near collapse: the barrier is zero there).
-      energies = setup.springs.evaluate(setup.positions, &gradient, &setup.normals);
-      ++result.evaluations;
-      layout.tangential(gradient, setup.normals, setup.curve_tangent, trial_q);
+      energies_ = setup_.springs.evaluate(setup_.positions, &gradient_, &setup_.normals);
+      ++result_.evaluations;
+      layout_.tangential(gradient_, setup_.normals, setup_.curve_tangent, trial_q_);
     }
-    q.swap(trial_q);
-    q_norm = std::sqrt(dot(q, q));
-    emit_frame(iteration + 1);
+    q_.swap(trial_q_);
+    q_norm_ = std::sqrt(dot(q_, q_));
   }
 
-  for (Eigen::Index k = 0; k < n; ++k) {
-    if (held[static_cast<std::size_t>(k)]) {
-      result.held_particles.push_back(setup.interior[static_cast<std::size_t>(k)]);
+  // The pair (s, y) of the accepted step, kept when s . y > 1e-12 |s| |y| (curvature condition);
+  // y is the change of the free part of the tangential gradient.
+  void remember_step() {
+    if (next_.s.size() != m_) {
+      resize_huge(next_.s, m_, 1);
+      resize_huge(next_.y, m_, 1);
+    }
+    for_chunks(n_, [&](Eigen::Index k) {
+      const auto p = static_cast<Eigen::Index>(setup_.interior[static_cast<std::size_t>(k)]);
+      const bool free = !held_[static_cast<std::size_t>(k)];
+      for (int c = 0; c < 3; ++c) {
+        next_.s[c * n_ + k] = trial_positions_(c, p) - setup_.positions(c, p);
+        next_.y[c * n_ + k] = free ? trial_q_[c * n_ + k] - q_free_[c * n_ + k] : 0.0;
+      }
+    });
+    const double sy = dot(next_.s, next_.y);
+    if (sy > 1e-12 * std::sqrt(dot(next_.s, next_.s) * dot(next_.y, next_.y)) && lb_.memory > 0) {
+      next_.rho = 1.0 / sy;
+      memory_.push_back(std::move(next_));
+      next_ = Pair{};
+      if (memory_.size() > static_cast<std::size_t>(lb_.memory)) {
+        next_ = std::move(memory_.front());
+        memory_.pop_front();
+      }
     }
   }
-  result.iterations = iteration;
-  result.solve_seconds = solver_detail::seconds_since(solve_start);
-  solver_detail::finish_result(setup, problem, initial_norm, result);
-  return result;
+
+  const long long start_ = solver_detail::now_ticks();
+  const RelaxationProblem& problem_;
+  const RelaxationOptions& options_;
+  const LbfgsOptions& lb_;
+  RelaxationSetup setup_;
+  RelaxationResult result_;
+  const long max_iterations_ = options_.max_iterations > 0 ? options_.max_iterations : 2000;
+  const Eigen::Index n_ = setup_.num_free();
+  const Eigen::Index m_ = 3 * n_;
+  const InteriorLayout layout_{&setup_, n_};
+  std::optional<solver_detail::LaplacianInverse> laplacian_;
+  bool with_barrier_ = false;
+  double noise_factor_ = 0.0;
+  double initial_norm_ = 0.0;  // the reference of the relative gradient test
+
+  // Current iterate: gradient, energies, tangential gradient q (and its free rows), folded corners.
+  Eigen::Matrix3Xd gradient_;
+  SpringEnergies energies_;
+  Eigen::VectorXd q_, q_free_;
+  double q_norm_ = 0.0;
+  std::vector<char> folded_;
+  std::vector<SurfaceDerivatives> frames_;  // tangent frames (du, dv) of the interior particles
+
+  // Held particles (see the file comment of lbfgs_solver.h): interior particles that the line
+  // search stopped from folding a face. They stay where they are, like boundary particles, until a
+  // release; the solver works in the subspace of the others: the held rows of the tangential
+  // gradient, of H0 = L^-1 and of the direction are zero.
+  std::vector<char> held_;
+  Eigen::Index held_count_ = 0;
+  int releases_ = 0;
+
+  // The step: direction, its slope, the memory of pairs and the storage of the next pair (the
+  // oldest pair's once the memory is full).
+  Eigen::VectorXd direction_, solved_;
+  double slope_ = 0.0;
+  std::deque<Pair> memory_;
+  Pair next_;
+
+  // The trial state (written by the retraction, evaluated by the line search).
+  Eigen::Matrix3Xd trial_positions_, trial_normals_, trial_gradient_, trial_tangents_;
+  std::vector<SurfacePoint> trial_points_;
+  std::vector<SurfaceDerivatives> trial_frames_;
+  std::vector<char> trial_folded_;
+  std::vector<double> trial_s_, trial_speed_;
+  SpringEnergies trial_energies_;
+  Eigen::VectorXd trial_q_;
+  bool trial_q_ready_ = false;  // trial_q_ already holds the trial's tangential gradient
+
+  long iteration_ = 0;
+  int stalled_ = 0;  // consecutive steps that changed the energy by less than its round-off
+  bool at_round_off_ = false;
+};
+
+}  // namespace
+
+RelaxationResult relax_lbfgs(const RelaxationProblem& problem, const RelaxationOptions& options) {
+  LbfgsRun run(problem, options);
+  return run.run();
 }
 
 }  // namespace elastic

@@ -40,13 +40,10 @@ SpringEnergyOptions energy_options(const RelaxationProblem& problem,
           .barrier_sigma = options.barrier_sigma};
 }
 
-}  // namespace
-
-RelaxationSetup::RelaxationSetup(const RelaxationProblem& problem, const RelaxationOptions& options)
-    : grid(checked_grid(problem)),
-      target(*problem.target),
-      springs(*problem.grid, energy_options(problem, options)),
-      num_particles(problem.grid->num_particles()) {
+void check_problem(const RelaxationProblem& problem, const RelaxationOptions& options,
+                   const RelaxationSetup& setup) {
+  const ParticleGrid& grid = setup.grid;
+  const int num_particles = setup.num_particles;
   const auto P = static_cast<std::size_t>(num_particles);
   if (problem.initial_positions.cols() != num_particles || problem.initial_points.size() != P) {
     throw InvalidInputError(kName, "initial positions/points do not have one entry per particle (" +
@@ -72,71 +69,93 @@ RelaxationSetup::RelaxationSetup(const RelaxationProblem& problem, const Relaxat
   }
   for (std::size_t p = 0; p < P; ++p) {
     if (!problem.initial_points[p].valid() ||
-        problem.initial_points[p].face >= target.surface().num_faces()) {
+        problem.initial_points[p].face >= setup.target.surface().num_faces()) {
       throw InvalidInputError(kName,
                               "particle " + std::to_string(p) + " has no valid surface point");
     }
   }
+}
 
-  interior_index.assign(P, -1);
-  is_free.assign(P, 0);
+// The free particles: the interior ones, then (sliding boundary) the boundary loop's, with their
+// curve parameters.
+void choose_free_particles(const RelaxationProblem& problem, const RelaxationOptions& options,
+                           RelaxationSetup& setup) {
+  const ParticleGrid& grid = setup.grid;
+  const auto P = static_cast<std::size_t>(setup.num_particles);
+  setup.interior_index.assign(P, -1);
+  setup.is_free.assign(P, 0);
+  const auto make_free = [&](std::size_t p) {
+    setup.interior_index[p] = static_cast<int>(setup.interior.size());
+    setup.is_free[p] = 1;
+    setup.interior.push_back(static_cast<int>(p));
+  };
   for (std::size_t p = 0; p < P; ++p) {
-    if (grid.is_boundary[p]) {
-      continue;
-    }
-    interior_index[p] = static_cast<int>(interior.size());
-    is_free[p] = 1;
-    interior.push_back(static_cast<int>(p));
-  }
-  sliding.assign(interior.size(), -1);
-  slide = options.boundary == BoundaryMode::Slide && options.solver == SolverKind::Fast;
-  if (slide) {
-    if (!problem.boundary_curve) {
-      throw InvalidInputError(kName, "a sliding boundary needs the target boundary curve");
-    }
-    const std::vector<double>& start =
-        problem.boundary_parameters.empty() ? grid.boundary_parameter : problem.boundary_parameters;
-    if (start.size() != grid.boundary_loop.size()) {
-      throw InvalidInputError(kName, "boundary parameters do not match the boundary loop");
-    }
-    curve = &problem.boundary_curve;
-    curve_s = start;
-    curve_speed.assign(start.size(), 0.0);
-    for (std::size_t k = 0; k < grid.boundary_loop.size(); ++k) {
-      const auto p = static_cast<std::size_t>(grid.boundary_loop[k]);
-      interior_index[p] = static_cast<int>(interior.size());
-      is_free[p] = 1;
-      interior.push_back(static_cast<int>(p));
-      sliding.push_back(static_cast<int>(k));
+    if (!grid.is_boundary[p]) {
+      make_free(p);
     }
   }
+  setup.sliding.assign(setup.interior.size(), -1);
+  setup.slide = options.boundary == BoundaryMode::Slide && options.solver == SolverKind::Fast;
+  if (!setup.slide) {
+    return;
+  }
+  if (!problem.boundary_curve) {
+    throw InvalidInputError(kName, "a sliding boundary needs the target boundary curve");
+  }
+  const std::vector<double>& start =
+      problem.boundary_parameters.empty() ? grid.boundary_parameter : problem.boundary_parameters;
+  if (start.size() != grid.boundary_loop.size()) {
+    throw InvalidInputError(kName, "boundary parameters do not match the boundary loop");
+  }
+  setup.curve = &problem.boundary_curve;
+  setup.curve_s = start;
+  setup.curve_speed.assign(start.size(), 0.0);
+  for (std::size_t k = 0; k < grid.boundary_loop.size(); ++k) {
+    make_free(static_cast<std::size_t>(grid.boundary_loop[k]));
+    setup.sliding.push_back(static_cast<int>(k));
+  }
+}
 
-  // Fresh buffers advised before they are written (core/huge_pages.h).
-  resize_huge(positions, 3, num_particles);
-  positions = problem.initial_positions;
-  points.reserve(P);
-  advise_huge_pages(points.data(), P * sizeof(SurfacePoint));
-  points.assign(problem.initial_points.begin(), problem.initial_points.end());
+// Positions, surface points and unit normals du x dv / |du x dv| at the given surface points (the
+// fold test and the tangent projection need them for every particle; interior ones are refreshed
+// by each retraction), in fresh buffers advised before they are written (core/huge_pages.h).
+void place_particles(const RelaxationProblem& problem, RelaxationSetup& setup) {
+  const auto P = static_cast<std::size_t>(setup.num_particles);
+  resize_huge(setup.positions, 3, setup.num_particles);
+  setup.positions = problem.initial_positions;
+  setup.points.reserve(P);
+  advise_huge_pages(setup.points.data(), P * sizeof(SurfacePoint));
+  setup.points.assign(problem.initial_points.begin(), problem.initial_points.end());
 
-  // Unit normals du x dv / |du x dv| at the given surface points (the fold test and the tangent
-  // projection need them for every particle; interior ones are refreshed by each retraction).
-  resize_huge(normals, 3, num_particles);
-  const LimitSurface& surface = target.surface();
-  tbb::parallel_for(tbb::blocked_range<int>(0, num_particles, 256),
+  resize_huge(setup.normals, 3, setup.num_particles);
+  const LimitSurface& surface = setup.target.surface();
+  tbb::parallel_for(tbb::blocked_range<int>(0, setup.num_particles, 256),
                     [&](const tbb::blocked_range<int>& range) {
                       for (int p = range.begin(); p != range.end(); ++p) {
-                        const SurfaceDerivatives d = surface.derivatives(points[p]);
+                        const SurfaceDerivatives d = surface.derivatives(setup.points[p]);
                         const Eigen::Vector3d n = d.du.cross(d.dv);
                         const double length = n.norm();
                         if (length > 1e-300) {
-                          normals.col(p) = n / length;
+                          setup.normals.col(p) = n / length;
                         } else {
                           // Degenerate parameterisation (a singular corner): ask the magnet.
-                          normals.col(p) = target.closest(positions.col(p), points[p]).normal;
+                          setup.normals.col(p) =
+                              setup.target.closest(setup.positions.col(p), setup.points[p]).normal;
                         }
                       }
                     });
+}
 
+}  // namespace
+
+RelaxationSetup::RelaxationSetup(const RelaxationProblem& problem, const RelaxationOptions& options)
+    : grid(checked_grid(problem)),
+      target(*problem.target),
+      springs(*problem.grid, energy_options(problem, options)),
+      num_particles(problem.grid->num_particles()) {
+  check_problem(problem, options, *this);
+  choose_free_particles(problem, options, *this);
+  place_particles(problem, *this);
   if (slide) {
     resize_huge(curve_tangent, 3, num_particles);
     curve_tangent.setZero();

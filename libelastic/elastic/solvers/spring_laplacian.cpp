@@ -20,128 +20,161 @@ namespace {
 
 const std::string kName = "relaxation";
 
+// Normal spring: C (|d| - k)^2 has Hessian 2C d d^T/|d|^2 at rest; the isotropic 2C I per
+// coordinate. Angular spring: e = x_i - (x_a + x_b)/2 = v . (x_i, x_a, x_b), Gram matrix
+// 2 C_a v v^T with v = (1, -1/2, -1/2): diagonal (2, 1/2, 1/2) C_a, (i,a) and (i,b) -C_a,
+// (a,b) +C_a/2. Hands every contribution (particle, particle, value) to `emit`.
+template <typename Emit>
+void visit_spring_hessian(const RelaxationSetup& setup, const RelaxationOptions& options,
+                          const Emit& emit) {
+  const double w = 2.0 * options.stiffness, ca = angular_stiffness(options);
+  for (const Spring& sp : setup.grid.springs) {
+    emit(sp.i, sp.i, w);
+    emit(sp.j, sp.j, w);
+    emit(sp.i, sp.j, -w);
+  }
+  for (const AngularSpring& sp : setup.grid.angular_springs) {
+    emit(sp.i, sp.i, 2.0 * ca);
+    emit(sp.a, sp.a, 0.5 * ca);
+    emit(sp.b, sp.b, 0.5 * ca);
+    emit(sp.i, sp.a, -ca);
+    emit(sp.i, sp.b, -ca);
+    emit(sp.a, sp.b, 0.5 * ca);
+  }
+}
+
+// The lower triangle of the interior Laplacian, column by column: entry (max, min) goes to column
+// min. Column c spans [start[c], start[c + 1]) of rows/values, its diagonal first. Counted and
+// scattered into per-column buckets, then each column sorted and its duplicates summed, in
+// parallel (a triplet list and Eigen's setFromTriplets took 2 s at a million particles).
+class LowerColumns {
+ public:
+  LowerColumns(const RelaxationSetup& setup, const RelaxationOptions& options)
+      : setup_(setup), options_(options), n_(setup.num_free()) {
+    count();
+    scatter();
+    sort_and_sum();
+  }
+
+  Eigen::SparseMatrix<double> matrix() const {
+    Eigen::SparseMatrix<double> laplacian(n_, n_);
+    std::int64_t nonzeros = 0;
+    for (const int k : kept_) {
+      nonzeros += k;
+    }
+    laplacian.resizeNonZeros(static_cast<Eigen::Index>(nonzeros));
+    int* outer = laplacian.outerIndexPtr();
+    outer[0] = 0;
+    for (int c = 0; c < n_; ++c) {
+      outer[c + 1] = outer[c] + kept_[static_cast<std::size_t>(c)];
+    }
+    tbb::parallel_for(tbb::blocked_range<int>(0, n_, 4096), [&](const tbb::blocked_range<int>& r) {
+      for (int c = r.begin(); c != r.end(); ++c) {
+        const auto from = static_cast<std::ptrdiff_t>(start_[static_cast<std::size_t>(c)]);
+        const auto length = static_cast<std::ptrdiff_t>(kept_[static_cast<std::size_t>(c)]);
+        std::copy(rows_.begin() + from, rows_.begin() + from + length,
+                  laplacian.innerIndexPtr() + outer[c]);
+        std::copy(values_.begin() + from, values_.begin() + from + length,
+                  laplacian.valuePtr() + outer[c]);
+      }
+    });
+    return laplacian;
+  }
+
+ private:
+  int interior(int p) const { return setup_.interior_index[static_cast<std::size_t>(p)]; }
+
+  // The diagonal, and start[c + 2] = the number of column c's off-diagonal entries plus one slot
+  // for the diagonal; then prefix sums, after which start[c + 1] is the fill position of column c.
+  void count() {
+    assign_huge(start_, static_cast<std::size_t>(n_) + 2, std::int64_t{0});
+    diagonal_ = Eigen::VectorXd::Zero(n_);
+    visit_spring_hessian(setup_, options_, [&](int p, int q, double value) {
+      const int a = interior(p), b = interior(q);
+      if (a < 0 || b < 0) {
+        return;
+      }
+      if (a == b) {
+        // A sliding boundary row is weighted up by a tenth: with no particle held the spring
+        // Laplacian is singular (translations), and the preconditioner must stay definite.
+        diagonal_[a] += setup_.sliding[static_cast<std::size_t>(a)] >= 0 ? 1.1 * value : value;
+      } else {
+        ++start_[static_cast<std::size_t>(std::min(a, b)) + 2];
+      }
+    });
+    for (int c = 0; c < n_; ++c) {
+      start_[static_cast<std::size_t>(c) + 2] += 1;
+    }
+    for (std::size_t c = 2; c < start_.size(); ++c) {
+      start_[c] += start_[c - 1];
+    }
+  }
+
+  // Fills the buckets (diagonal first); afterwards start[c] is column c's start again.
+  void scatter() {
+    assign_huge(rows_, static_cast<std::size_t>(start_.back()));
+    assign_huge(values_, rows_.size());
+    for (int c = 0; c < n_; ++c) {
+      const auto slot = static_cast<std::size_t>(start_[static_cast<std::size_t>(c) + 1]++);
+      rows_[slot] = c;
+      values_[slot] = diagonal_[c];
+    }
+    visit_spring_hessian(setup_, options_, [&](int p, int q, double value) {
+      const int a = interior(p), b = interior(q);
+      if (a < 0 || b < 0 || a == b) {
+        return;
+      }
+      const auto slot =
+          static_cast<std::size_t>(start_[static_cast<std::size_t>(std::min(a, b)) + 1]++);
+      rows_[slot] = std::max(a, b);
+      values_[slot] = value;
+    });
+  }
+
+  // Sorts each column by row (a dozen entries: insertion sort) and sums duplicates in place;
+  // kept[c] receives the column's length.
+  void sort_and_sum() {
+    kept_.assign(static_cast<std::size_t>(n_), 0);
+    tbb::parallel_for(tbb::blocked_range<int>(0, n_, 4096), [&](const tbb::blocked_range<int>& r) {
+      for (int c = r.begin(); c != r.end(); ++c) {
+        const auto first = static_cast<std::size_t>(start_[static_cast<std::size_t>(c)]);
+        const auto last = static_cast<std::size_t>(start_[static_cast<std::size_t>(c) + 1]);
+        for (std::size_t i = first + 1; i < last; ++i) {
+          for (std::size_t j = i; j > first && rows_[j - 1] > rows_[j]; --j) {
+            std::swap(rows_[j - 1], rows_[j]);
+            std::swap(values_[j - 1], values_[j]);
+          }
+        }
+        std::size_t out = first;
+        for (std::size_t i = first + 1; i < last; ++i) {
+          if (rows_[i] == rows_[out]) {
+            values_[out] += values_[i];
+          } else {
+            ++out;
+            rows_[out] = rows_[i];
+            values_[out] = values_[i];
+          }
+        }
+        kept_[static_cast<std::size_t>(c)] = static_cast<int>(out + 1 - first);
+      }
+    });
+  }
+
+  const RelaxationSetup& setup_;
+  const RelaxationOptions& options_;
+  const int n_;
+  std::vector<std::int64_t> start_;
+  Eigen::VectorXd diagonal_;
+  std::vector<int> rows_;
+  std::vector<double> values_;
+  std::vector<int> kept_;
+};
+
 }  // namespace
 
 Eigen::SparseMatrix<double> interior_laplacian(const RelaxationSetup& setup,
                                                const RelaxationOptions& options) {
-  const int n = setup.num_free();
-  // Normal spring: C (|d| - k)^2 has Hessian 2C d d^T/|d|^2 at rest; the isotropic 2C I per
-  // coordinate. Angular spring: e = x_i - (x_a + x_b)/2 = v . (x_i, x_a, x_b), Gram matrix
-  // 2 C_a v v^T with v = (1, -1/2, -1/2): diagonal (2, 1/2, 1/2) C_a, (i,a) and (i,b) -C_a,
-  // (a,b) +C_a/2. `visit` hands every contribution (particle, particle, value) to `emit`.
-  const double w = 2.0 * options.stiffness, ca = angular_stiffness(options);
-  const auto visit = [&](const auto& emit) {
-    for (const Spring& sp : setup.grid.springs) {
-      emit(sp.i, sp.i, w);
-      emit(sp.j, sp.j, w);
-      emit(sp.i, sp.j, -w);
-    }
-    for (const AngularSpring& sp : setup.grid.angular_springs) {
-      emit(sp.i, sp.i, 2.0 * ca);
-      emit(sp.a, sp.a, 0.5 * ca);
-      emit(sp.b, sp.b, 0.5 * ca);
-      emit(sp.i, sp.a, -ca);
-      emit(sp.i, sp.b, -ca);
-      emit(sp.a, sp.b, 0.5 * ca);
-    }
-  };
-  // Only the lower triangle is stored (what the LDL^T factorisation reads), column by column:
-  // entry (max, min) goes to column min. Counted, scattered into per-column buckets, then each
-  // column sorted and its duplicates summed, in parallel (a triplet list and Eigen's
-  // setFromTriplets took 2 s at a million particles).
-  const auto interior = [&](int p) { return setup.interior_index[static_cast<std::size_t>(p)]; };
-  std::vector<std::int64_t> start;
-  assign_huge(start, static_cast<std::size_t>(n) + 2, std::int64_t{0});
-  Eigen::VectorXd diagonal = Eigen::VectorXd::Zero(n);
-  visit([&](int p, int q, double value) {
-    const int a = interior(p), b = interior(q);
-    if (a < 0 || b < 0) {
-      return;
-    }
-    if (a == b) {
-      // A sliding boundary row is weighted up by a tenth: with no particle held the spring
-      // Laplacian is singular (translations), and the preconditioner must stay definite.
-      diagonal[a] += setup.sliding[static_cast<std::size_t>(a)] >= 0 ? 1.1 * value : value;
-    } else {
-      ++start[static_cast<std::size_t>(std::min(a, b)) + 2];
-    }
-  });
-  // start[c + 2] counts column c's off-diagonal entries; one more slot per column for the
-  // diagonal, stored first.
-  for (int c = 0; c < n; ++c) {
-    start[static_cast<std::size_t>(c) + 2] += 1;
-  }
-  for (std::size_t c = 2; c < start.size(); ++c) {
-    start[c] += start[c - 1];
-  }
-  std::vector<int> rows;
-  std::vector<double> values;
-  assign_huge(rows, static_cast<std::size_t>(start.back()));
-  assign_huge(values, rows.size());
-  // start[c + 1] is now the fill position of column c.
-  for (int c = 0; c < n; ++c) {
-    const auto slot = static_cast<std::size_t>(start[static_cast<std::size_t>(c) + 1]++);
-    rows[slot] = c;
-    values[slot] = diagonal[c];
-  }
-  visit([&](int p, int q, double value) {
-    const int a = interior(p), b = interior(q);
-    if (a < 0 || b < 0 || a == b) {
-      return;
-    }
-    const auto slot =
-        static_cast<std::size_t>(start[static_cast<std::size_t>(std::min(a, b)) + 1]++);
-    rows[slot] = std::max(a, b);
-    values[slot] = value;
-  });
-  // Column c spans [start[c], start[c + 1]). Sort by row (a dozen entries: insertion sort) and sum
-  // duplicates in place; `kept` receives each column's length.
-  std::vector<int> kept(static_cast<std::size_t>(n));
-  tbb::parallel_for(tbb::blocked_range<int>(0, n, 4096), [&](const tbb::blocked_range<int>& r) {
-    for (int c = r.begin(); c != r.end(); ++c) {
-      const auto first = static_cast<std::size_t>(start[static_cast<std::size_t>(c)]);
-      const auto last = static_cast<std::size_t>(start[static_cast<std::size_t>(c) + 1]);
-      for (std::size_t i = first + 1; i < last; ++i) {
-        for (std::size_t j = i; j > first && rows[j - 1] > rows[j]; --j) {
-          std::swap(rows[j - 1], rows[j]);
-          std::swap(values[j - 1], values[j]);
-        }
-      }
-      std::size_t out = first;
-      for (std::size_t i = first + 1; i < last; ++i) {
-        if (rows[i] == rows[out]) {
-          values[out] += values[i];
-        } else {
-          ++out;
-          rows[out] = rows[i];
-          values[out] = values[i];
-        }
-      }
-      kept[static_cast<std::size_t>(c)] = static_cast<int>(out + 1 - first);
-    }
-  });
-  Eigen::SparseMatrix<double> laplacian(n, n);
-  std::int64_t nonzeros = 0;
-  for (const int k : kept) {
-    nonzeros += k;
-  }
-  laplacian.resizeNonZeros(static_cast<Eigen::Index>(nonzeros));
-  int* outer = laplacian.outerIndexPtr();
-  outer[0] = 0;
-  for (int c = 0; c < n; ++c) {
-    outer[c + 1] = outer[c] + kept[static_cast<std::size_t>(c)];
-  }
-  tbb::parallel_for(tbb::blocked_range<int>(0, n, 4096), [&](const tbb::blocked_range<int>& r) {
-    for (int c = r.begin(); c != r.end(); ++c) {
-      const auto from = static_cast<std::ptrdiff_t>(start[static_cast<std::size_t>(c)]);
-      const auto count = static_cast<std::ptrdiff_t>(kept[static_cast<std::size_t>(c)]);
-      std::copy(rows.begin() + from, rows.begin() + from + count,
-                laplacian.innerIndexPtr() + outer[c]);
-      std::copy(values.begin() + from, values.begin() + from + count,
-                laplacian.valuePtr() + outer[c]);
-    }
-  });
-  return laplacian;
+  return LowerColumns(setup, options).matrix();
 }
 
 Eigen::Matrix3Xd interior_coordinates(const RelaxationSetup& setup) {
