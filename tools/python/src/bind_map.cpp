@@ -1,0 +1,476 @@
+// The map for Python: elastic.map_regions (every option of `elastic map` as a keyword), the Map it
+// returns (particles, metrics, forward and inverse for arrays of surface points, the LSCM/ARAP/DCM
+// baselines on its grid) and Map.paste, which writes the files `elastic paste` writes.
+#include <pybind11/stl.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include <Eigen/Geometry>
+#include <cmath>
+
+#include "arrays.h"
+#include "elastic/baselines/baseline_map.h"
+#include "elastic/core/staged_folder.h"
+#include "elastic/transfer/output_folder.h"
+#include "elastic/transfer/paste.h"
+#include "session.h"
+
+namespace elastic::python {
+
+namespace {
+
+// The range of `particles` (the CLI's --particles).
+constexpr long kMinParticles = 16;
+constexpr long kMaxParticles = 5'000'000;
+
+template <typename T>
+T parsed(const std::string& text, const char* name,
+         T (*parse)(std::string_view, std::string_view)) {
+  return parse(text, name);
+}
+
+struct MapKeywords {
+  long particles = 1000;
+  std::string solver = "lbfgs", energy = "robust", rest_scale = "auto", boundary = "auto";
+  std::string boundary_offset = "auto", preconditioner = "multigrid";
+  py::object angular_stiffness;
+  int subdivide = 0, threads = 0;
+  double jitter = 0.0;
+  unsigned long seed = 0;
+  long max_iterations = 0;
+};
+
+// The MapOptions of `elastic map` for the same flags (tools/elastic/map_job.cpp).
+MapOptions map_options(const MapKeywords& k) {
+  if (k.particles < kMinParticles || k.particles > kMaxParticles) {
+    throw py::value_error("particles: " + std::to_string(k.particles) + " is outside [" +
+                          std::to_string(kMinParticles) + ", " + std::to_string(kMaxParticles) +
+                          "]");
+  }
+  if (k.solver != "lbfgs" && k.solver != "explicit") {
+    throw py::value_error("solver: expected 'lbfgs' or 'explicit', got '" + k.solver + "'");
+  }
+  if (k.boundary_offset != "auto" && k.boundary_offset != "anchor") {
+    throw py::value_error("boundary_offset: expected 'auto' or 'anchor', got '" +
+                          k.boundary_offset + "'");
+  }
+  if (k.subdivide < 0 || k.subdivide > 4 || k.threads < 0 || k.max_iterations < 0) {
+    throw py::value_error("subdivide (0..4), threads and max_iterations (>= 0) out of range");
+  }
+  if (!(k.jitter >= 0.0 && k.jitter <= 1.0)) {
+    throw py::value_error("jitter: expected a fraction in [0, 1], got " + std::to_string(k.jitter));
+  }
+  if (k.seed != 0 && k.jitter == 0.0) {
+    throw py::value_error("seed: chooses the random start of jitter, which is 0: give jitter");
+  }
+  MapOptions options;
+  options.sampling.layout.particles = k.particles;
+  options.sampling.layout.name = "source_region";
+  options.sampling.sampling.seed = k.seed;
+  options.sampling.sampling.jitter = k.jitter;
+  options.rest_scale = parse_rest_scale(k.rest_scale, "rest_scale");
+  options.relaxation.solver = k.solver == "explicit" ? SolverKind::Faithful : SolverKind::Fast;
+  options.relaxation.energy = parse_energy_kind(k.energy, "energy");
+  options.choose_offset = k.boundary_offset == "auto";
+  options.relaxation.boundary = k.boundary == "auto"
+                                    ? (k.subdivide > 0 ? BoundaryMode::Fixed : BoundaryMode::Slide)
+                                    : parse_boundary_mode(k.boundary, "boundary");
+  options.relaxation.lbfgs.preconditioner =
+      parse_preconditioner(k.preconditioner, "preconditioner");
+  options.relaxation.threads = k.threads;
+  options.relaxation.max_iterations = k.max_iterations;
+  if (!k.angular_stiffness.is_none()) {
+    const double ca = k.angular_stiffness.cast<double>();
+    if (!(ca >= 0.0 && ca <= 100.0)) {
+      throw py::value_error("angular_stiffness: expected C_a / C in [0, 100], got " +
+                            std::to_string(ca));
+    }
+    options.relaxation.angular_stiffness = ca;
+  }
+  options.subdivisions = k.subdivide;
+  return options;
+}
+
+std::shared_ptr<MapState> run_map(const std::shared_ptr<RegionState>& source_region,
+                                  const std::shared_ptr<RegionState>& target_region,
+                                  const MapKeywords& keywords, const py::object& progress) {
+  MapOptions options = map_options(keywords);
+  PythonProgress listener(progress);
+  options.progress = listener.callback();
+  options.relaxation.progress = options.progress;
+  auto state = std::make_shared<MapState>();
+  state->source = source_region->surface;
+  state->target = target_region->surface;
+  state->source_region = source_region;
+  state->target_region = target_region;
+  std::exception_ptr failure;
+  {
+    const py::gil_scoped_release release;
+    tbb::task_arena arena(keywords.threads > 0 ? keywords.threads : tbb::task_arena::automatic);
+    try {
+      arena.execute([&] {
+        state->result = map_regions(*state->source->projector, source_region->region,
+                                    *state->target->projector, target_region->region, options);
+        state->metrics = measure_on_target(*state, state->result.relaxation.positions,
+                                           state->result.relaxation.points);
+        state->naive_metrics =
+            measure_on_target(*state, state->result.naive.positions, state->result.naive.points);
+      });
+    } catch (...) {
+      failure = std::current_exception();
+    }
+  }
+  listener.rethrow();  // Ctrl-C or the callback's own exception wins over "cancelled"
+  if (failure) {
+    std::rethrow_exception(failure);
+  }
+  return state;
+}
+
+py::dict locations(const std::vector<Mapping::Location>& found) {
+  const auto n = static_cast<py::ssize_t>(found.size());
+  py::array_t<bool> inside(n);
+  Float64Array position = new_rows(n, 3);
+  std::vector<SurfacePoint> points(found.size());
+  bool* in = inside.mutable_data();
+  auto* p = reinterpret_cast<Eigen::Vector3d*>(position.mutable_data());
+  for (std::size_t i = 0; i < found.size(); ++i) {
+    in[i] = found[i].inside;
+    points[i] = found[i].inside ? found[i].point : SurfacePoint{};
+    p[i] = found[i].inside ? found[i].position
+                           : Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
+  }
+  py::dict out = points_dict(points);
+  out["inside"] = inside;
+  out["position"] = position;
+  return out;
+}
+
+// Mapping::forward or inverse for arrays of surface points, in parallel without the GIL.
+py::dict map_points(const MapState& m, const py::handle& face, const py::handle& uv, bool forward) {
+  const std::vector<SurfacePoint> points = surface_points(face, uv);
+  const LimitSurface& surface = forward ? *m.source->surface : *m.target->surface;
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    if (points[i].face < 0 || points[i].face >= surface.num_faces()) {
+      throw py::value_error("face: entry " + std::to_string(i) + " is " +
+                            std::to_string(points[i].face) + ", outside [0, " +
+                            std::to_string(surface.num_faces()) + ")");
+    }
+  }
+  std::vector<Mapping::Location> found(points.size());
+  {
+    const py::gil_scoped_release release;
+    const Mapping& mapping = m.result.mapping;
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, points.size(), 1024),
+                      [&](const tbb::blocked_range<std::size_t>& r) {
+                        for (std::size_t i = r.begin(); i != r.end(); ++i) {
+                          found[i] =
+                              forward ? mapping.forward(points[i]) : mapping.inverse(points[i]);
+                        }
+                      });
+  }
+  return locations(found);
+}
+
+py::dict baseline(const MapState& m, const std::string& kind) {
+  BaselineOptions options;
+  options.kind = parse_baseline_kind(kind, "kind");
+  options.target_offset = m.result.boundary_offset;
+  BaselineResult result;
+  MapMetrics metrics;
+  {
+    const py::gil_scoped_release release;
+    result = map_baseline(m.result.sampling.grid, *m.source->projector, m.source_region->region,
+                          *m.target->projector, m.target_region->region, options);
+    metrics = measure_on_target(m, result.positions, result.points, result.outside);
+  }
+  py::dict out;
+  out["kind"] = std::string(to_string(result.kind));
+  out["positions"] = rows_of(result.positions);
+  py::array_t<bool> outside(static_cast<py::ssize_t>(result.outside.size()));
+  std::copy(result.outside.begin(), result.outside.end(), outside.mutable_data());
+  out["outside"] = outside;
+  out["metrics"] = metrics_dict(metrics);
+  out["seconds"] = result.seconds;
+  return out;
+}
+
+std::vector<std::string> paste_files(const MapState& m, const std::string& out,
+                                     const std::string& color, const py::object& texture, bool bake,
+                                     const std::string& height, const py::object& height_image,
+                                     double height_scale, const py::object& progress) {
+  PasteOptions options;
+  if (color == "auto")
+    options.color = PasteColor::Auto;
+  else if (color == "texture")
+    options.color = PasteColor::Texture;
+  else if (color == "vertex")
+    options.color = PasteColor::Vertex;
+  else if (color == "none")
+    options.color = PasteColor::None;
+  else
+    throw py::value_error("color: expected 'auto', 'texture', 'vertex' or 'none', got '" + color +
+                          "'");
+  if (height == "none")
+    options.height = PasteHeight::None;
+  else if (height == "image")
+    options.height = PasteHeight::Image;
+  else if (height == "luminance")
+    options.height = PasteHeight::Luminance;
+  else
+    throw py::value_error("height: expected 'none', 'image' or 'luminance', got '" + height + "'");
+  if (!texture.is_none()) options.texture = texture.cast<std::string>();
+  if (!height_image.is_none()) options.height_image = height_image.cast<std::string>();
+  if (options.height == PasteHeight::Image && options.height_image.empty()) {
+    throw py::value_error("height_image: needed with height='image'");
+  }
+  options.bake = bake;
+  options.height_scale = height_scale;
+  PythonProgress listener(progress);
+  options.progress = listener.callback();
+  std::vector<std::string> written;
+  std::exception_ptr failure;
+  {
+    const py::gil_scoped_release release;
+    try {
+      // Staged like `elastic paste --out`: the files appear together, or not at all.
+      StagedFolder staged(out, "out");
+      const PasteResult pasted =
+          paste(*m.source->projector, m.source_region->region, *m.target->projector,
+                m.target_region->region, m.result, options);
+      if (!pasted.cancelled) {
+        OutputFolder folder(staged.staging());
+        for (const auto& f : write_paste(folder, pasted)) {
+          written.push_back(
+              (staged.destination() / f.lexically_relative(staged.staging())).string());
+        }
+        staged.commit();
+      }
+    } catch (...) {
+      failure = std::current_exception();
+    }
+  }
+  listener.rethrow();
+  if (failure) {
+    std::rethrow_exception(failure);
+  }
+  if (listener.stopped()) {
+    throw py::value_error("paste: stopped by the progress callback; nothing was written");
+  }
+  return written;
+}
+
+}  // namespace
+
+MapMetrics measure_on_target(const MapState& map, const Eigen::Matrix3Xd& positions,
+                             const std::vector<SurfacePoint>& points, std::vector<char> outside) {
+  MapMetricsOptions options;
+  options.rest_scale = map.result.rest_scale;
+  outside.resize(points.size(), 0);
+  for (std::size_t p = 0; p < points.size(); ++p) {
+    if (!points[p].valid()) outside[p] = 1;
+  }
+  options.target_normals = surface_normals(*map.target->surface, points, outside);
+  options.outside = std::move(outside);
+  return measure_map(map.result.sampling.grid, positions, options);
+}
+
+py::dict metrics_dict(const MapMetrics& m) {
+  py::dict out;
+  out["length_energy"] = m.length_energy;
+  out["angle_error_mean_deg"] = m.angle_error_mean_deg;
+  out["angle_error_max_deg"] = m.angle_error_max_deg;
+  out["stretch_l2"] = m.stretch_l2;
+  out["stretch_linf"] = m.stretch_linf;
+  out["inverse_stretch_l2"] = m.inverse_stretch_l2;
+  out["inverse_stretch_linf"] = m.inverse_stretch_linf;
+  out["area_distortion"] = m.area_distortion;
+  out["conformal_distortion"] = m.conformal_distortion;
+  out["symmetric_dirichlet"] = m.symmetric_dirichlet;
+  out["folds"] = m.folds;
+  out["sigma_min"] = m.sigma_min;
+  out["degenerate"] = m.degenerate;
+  out["outside"] = m.outside;
+  out["measured_triangles"] = m.measured_triangles;
+  return out;
+}
+
+void bind_map(py::module_& m) {
+  m.def(
+      "map_regions",
+      [](const std::shared_ptr<RegionState>& source_region,
+         const std::shared_ptr<RegionState>& target_region, long particles,
+         const std::string& solver, const std::string& energy, const std::string& rest_scale,
+         const std::string& boundary, const std::string& boundary_offset,
+         const std::string& preconditioner, const py::object& angular_stiffness, int subdivide,
+         int threads, double jitter, unsigned long seed, long max_iterations,
+         const py::object& progress) {
+        const MapKeywords k{particles,     solver,          energy,         rest_scale,
+                            boundary,      boundary_offset, preconditioner, angular_stiffness,
+                            subdivide,     threads,         jitter,         seed,
+                            max_iterations};
+        return run_map(source_region, target_region, k, progress);
+      },
+      py::arg("source_region"), py::arg("target_region"), py::kw_only(),
+      py::arg("particles") = 1000, py::arg("solver") = "lbfgs", py::arg("energy") = "robust",
+      py::arg("rest_scale") = "auto", py::arg("boundary") = "auto",
+      py::arg("boundary_offset") = "auto", py::arg("preconditioner") = "multigrid",
+      py::arg("angular_stiffness") = py::none(), py::arg("subdivide") = 0, py::arg("threads") = 0,
+      py::arg("jitter") = 0.0, py::arg("seed") = 0, py::arg("max_iterations") = 0,
+      py::arg("progress") = py::none(),
+      "Maps source_region onto target_region (each a Region of its Surface) with the particle "
+      "system: the keywords are the flags of `elastic map` (docs/cli.md) with underscores. "
+      "progress: called as progress(stage, iteration, total, energy, gradient); return False to "
+      "stop. Runs without the GIL; Ctrl-C raises KeyboardInterrupt. -> Map. A map that did not "
+      "converge or has folds is returned (check Map.ok), as `elastic map` writes its report "
+      "before exiting 70.");
+
+  py::class_<MapState, std::shared_ptr<MapState>>(
+      m, "Map",
+      "A relaxed map between two regions: its particles on both surfaces, its distortion "
+      "(docs/metrics.md), and forward/inverse queries.")
+      .def_property_readonly(
+          "ok",
+          [](const MapState& s) { return s.result.relaxation.converged && s.metrics.folds == 0; },
+          "The verdict of `elastic map`: converged and fold-free.")
+      .def_property_readonly(
+          "converged", [](const MapState& s) { return s.result.relaxation.converged; },
+          "Whether the solver's stop is a convergence (the report's 'converged').")
+      .def_property_readonly(
+          "reason",
+          [](const MapState& s) { return std::string(to_string(s.result.relaxation.reason)); },
+          "The solver's stop reason, as in the CLI report.")
+      .def_property_readonly(
+          "iterations", [](const MapState& s) { return s.result.relaxation.iterations; },
+          "Solver iterations (L-BFGS) or time steps (explicit).")
+      .def_property_readonly(
+          "folds", [](const MapState& s) { return s.metrics.folds; },
+          "Folded faces of the final map (docs/metrics.md), the report's 'folds'.")
+      .def_property_readonly(
+          "sigma_min", [](const MapState& s) { return s.metrics.sigma_min; },
+          "Worst signed sigma_min over the grid triangles, divided by the rest scale.")
+      .def_property_readonly(
+          "rest_scale", [](const MapState& s) { return s.result.rest_scale; },
+          "sigma, the factor on the source's rest lengths (the report's rest_scale.factor).")
+      .def_property_readonly(
+          "energy",
+          [](const MapState& s) {
+            const RelaxationResult& x = s.result.relaxation;
+            py::dict e;
+            e["length"] = x.length_energy;
+            e["angle"] = x.angular_energy;
+            e["barrier"] = x.barrier_energy;
+            e["initial"] = x.initial_energy;
+            return e;
+          },
+          "The solver's final energies (the report's 'energy').")
+      .def_property_readonly(
+          "seconds",
+          [](const MapState& s) {
+            const MapResult& r = s.result;
+            py::dict d;
+            d["sampling"] = r.seconds_sampling;
+            d["naive_map"] = r.seconds_naive;
+            d["solver_setup"] = r.relaxation.setup_seconds;
+            d["solve"] = r.relaxation.solve_seconds;
+            d["mapping"] = r.seconds_mapping;
+            return d;
+          },
+          "Wall seconds of the map's stages.")
+      .def_property_readonly(
+          "num_particles", [](const MapState& s) { return s.result.sampling.grid.num_particles(); },
+          "P, the number of particles.")
+      .def_property_readonly(
+          "source_positions",
+          [](const MapState& s) {
+            const ParticleGrid& g = s.result.sampling.grid;
+            Float64Array out = new_rows(g.num_particles(), 3);
+            auto rows = out.mutable_unchecked<2>();
+            for (int i = 0; i < g.num_particles(); ++i) {
+              const auto& p = g.mesh.point(GridMesh::VertexHandle(i));
+              for (int c = 0; c < 3; ++c) rows(i, c) = p[c];
+            }
+            return out;
+          },
+          "(P, 3) float64 particles on the source.")
+      .def_property_readonly(
+          "source_points",
+          [](const MapState& s) { return points_dict(s.result.sampling.grid.source_points); },
+          "The particles as source surface points: dict 'face', 'uv'.")
+      .def_property_readonly(
+          "target_positions",
+          [](const MapState& s) { return rows_of(s.result.relaxation.positions); },
+          "(P, 3) float64 particles on the target (the relaxed map).")
+      .def_property_readonly(
+          "target_points",
+          [](const MapState& s) { return points_dict(s.result.relaxation.points); },
+          "The particles as target surface points: dict 'face', 'uv'.")
+      .def_property_readonly(
+          "naive_positions", [](const MapState& s) { return rows_of(s.result.naive.positions); },
+          "(P, 3) float64 start of the relaxation (the composed disk maps).")
+      .def_property_readonly(
+          "triangles", [](const MapState& s) { return triangles_of(s.metrics.triangles); },
+          "(T, 3) int32 grid triangles (each quad split once), as the metrics use them.")
+      .def_property_readonly(
+          "boundary",
+          [](const MapState& s) {
+            const auto& loop = s.result.sampling.grid.boundary_loop;
+            Int32Array out = new_ints(static_cast<py::ssize_t>(loop.size()));
+            std::copy(loop.begin(), loop.end(), out.mutable_data());
+            return out;
+          },
+          "(B,) int32 boundary particles in order.")
+      .def(
+          "metrics", [](const MapState& s) { return metrics_dict(s.metrics); },
+          "Distortion of the final map (docs/metrics.md): length energy, angle error, stretch, "
+          "area and conformal distortion, symmetric Dirichlet, folds, sigma_min.")
+      .def(
+          "naive_metrics", [](const MapState& s) { return metrics_dict(s.naive_metrics); },
+          "The same for the naive start.")
+      .def(
+          "per_triangle",
+          [](const MapState& s, const std::string& name) {
+            const std::vector<double>& v =
+                s.metrics.per_triangle.values(parse_triangle_metric(name, "name"));
+            Float64Array out = new_rows(static_cast<py::ssize_t>(v.size()), 0);
+            std::copy(v.begin(), v.end(), out.mutable_data());
+            return out;
+          },
+          py::arg("name"),
+          "(T,) float64 values of one metric per grid triangle ('angle_error_deg', 'stretch_l2', "
+          "'stretch_linf', 'inverse_stretch_l2', 'area_distortion', 'conformal_distortion', "
+          "'symmetric_dirichlet'); NaN for excluded triangles.")
+      .def(
+          "forward",
+          [](const MapState& s, const py::handle& face, const py::handle& uv) {
+            return map_points(s, face, uv, true);
+          },
+          py::arg("face"), py::arg("uv"),
+          "Source surface points -> target: dict 'inside' (N,) bool, 'face', 'uv', 'position' "
+          "(NaN outside the mapped region).")
+      .def(
+          "inverse",
+          [](const MapState& s, const py::handle& face, const py::handle& uv) {
+            return map_points(s, face, uv, false);
+          },
+          py::arg("face"), py::arg("uv"), "Target surface points -> source, as forward.")
+      .def("baseline", &baseline, py::arg("kind") = "lscm",
+           "A baseline map ('lscm', 'arap' or 'dcm', CGAL) of the same grid, as `elastic compare` "
+           "runs it -> dict 'positions', 'outside', 'metrics', 'seconds'.")
+      .def("paste", &paste_files, py::arg("out"), py::kw_only(), py::arg("color") = "auto",
+           py::arg("texture") = py::none(), py::arg("bake") = false, py::arg("height") = "none",
+           py::arg("height_image") = py::none(), py::arg("height_scale") = 0.1,
+           py::arg("progress") = py::none(),
+           "Pastes the source's colour (and height) onto the target through the map and writes "
+           "the files of `elastic paste` (painted OBJ/MTL and textures, colours PLY, baked and "
+           "displaced meshes when asked) into the folder `out`, all together or none. -> the "
+           "paths written.")
+      .def("__repr__", [](const MapState& s) {
+        return "<elastic.Map " + std::to_string(s.result.sampling.grid.num_particles()) +
+               " particles, " + (s.result.relaxation.converged ? "converged" : "not converged") +
+               ", " + std::to_string(s.metrics.folds) + " folds>";
+      });
+}
+
+}  // namespace elastic::python
