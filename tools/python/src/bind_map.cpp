@@ -12,6 +12,7 @@
 #include "arrays.h"
 #include "elastic/baselines/baseline_map.h"
 #include "elastic/core/staged_folder.h"
+#include "elastic/mesh/mesh_io.h"
 #include "elastic/transfer/output_folder.h"
 #include "elastic/transfer/paste.h"
 #include "session.h"
@@ -180,6 +181,61 @@ py::dict map_points(const MapState& m, const py::handle& face, const py::handle&
   return out;
 }
 
+// Tangent vectors at source points carried to the target by the map's differential (J v, or its
+// rotation part for directions), with the mapped points.
+py::dict transport_vectors(MapState& m, const py::handle& face, const py::handle& uv,
+                           const py::handle& vectors, const std::string& mode) {
+  VectorTransport transport = VectorTransport::Stretch;
+  if (mode == "rotation") {
+    transport = VectorTransport::Rotation;
+  } else if (mode != "stretch") {
+    throw py::value_error("mode: expected 'stretch' or 'rotation', got '" + mode + "'");
+  }
+  const std::vector<SurfacePoint> points = surface_points(face, uv);
+  const Float64Array v = float_rows(vectors, "vectors", 3);
+  if (v.shape(0) != static_cast<py::ssize_t>(points.size())) {
+    throw py::value_error("vectors: expected one per point (" + std::to_string(points.size()) +
+                          "), got " + std::to_string(v.shape(0)));
+  }
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    if (points[i].face < 0 || points[i].face >= m.source->surface->num_faces()) {
+      throw py::value_error("face: entry " + std::to_string(i) + " is outside the source's faces");
+    }
+  }
+  const auto in = as_vectors(v);
+  const auto n = static_cast<py::ssize_t>(points.size());
+  py::array_t<bool> inside(n);
+  Float64Array out = new_rows(n, 3), position = new_rows(n, 3);
+  bool* ok = inside.mutable_data();
+  auto* o = reinterpret_cast<Eigen::Vector3d*>(out.mutable_data());
+  auto* p = reinterpret_cast<Eigen::Vector3d*>(position.mutable_data());
+  {
+    const py::gil_scoped_release release;
+    std::call_once(m.differential_once, [&] {
+      m.differential =
+          std::make_unique<MapDifferential>(*m.source->surface, *m.target->surface, m.result);
+    });
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, points.size(), 1024),
+                      [&](const tbb::blocked_range<std::size_t>& r) {
+                        for (std::size_t i = r.begin(); i != r.end(); ++i) {
+                          const Mapping::Location l = m.result.mapping.forward(points[i]);
+                          ok[i] = l.inside;
+                          const double nan = std::numeric_limits<double>::quiet_NaN();
+                          p[i] = l.inside ? l.position : Eigen::Vector3d::Constant(nan);
+                          o[i] = l.inside ? Eigen::Vector3d(m.differential->transport_forward(
+                                                                points[i], l, transport) *
+                                                            in[i])
+                                          : Eigen::Vector3d::Constant(nan);
+                        }
+                      });
+  }
+  py::dict result;
+  result["inside"] = inside;
+  result["position"] = position;
+  result["vectors"] = out;
+  return result;
+}
+
 py::dict baseline(const MapState& m, const std::string& kind) {
   BaselineOptions options;
   options.kind = parse_baseline_kind(kind, "kind");
@@ -206,7 +262,8 @@ py::dict baseline(const MapState& m, const std::string& kind) {
 std::vector<std::string> paste_files(const MapState& m, const std::string& out,
                                      const std::string& color, const py::object& texture, bool bake,
                                      const std::string& height, const py::object& height_image,
-                                     double height_scale, const py::object& progress) {
+                                     double height_scale, const py::object& detail,
+                                     double detail_scale, const py::object& progress) {
   PasteOptions options;
   if (color == "auto")
     options.color = PasteColor::Auto;
@@ -234,6 +291,18 @@ std::vector<std::string> paste_files(const MapState& m, const std::string& out,
   }
   options.bake = bake;
   options.height_scale = height_scale;
+  std::optional<PolygonMesh> detail_mesh;
+  if (!detail.is_none()) {
+    if (py::isinstance<py::str>(detail)) {
+      const std::string path = detail.cast<std::string>();
+      detail_mesh = read_mesh(path).mesh;
+      options.detail_name = path;
+    } else {
+      detail_mesh = detail.cast<const PolygonMesh&>();
+    }
+    options.detail = &*detail_mesh;
+    options.detail_scale = detail_scale;
+  }
   PythonProgress listener(progress);
   options.progress = listener.callback();
   std::vector<std::string> written;
@@ -468,11 +537,19 @@ void bind_map(py::module_& m) {
       .def("paste", &paste_files, py::arg("out"), py::kw_only(), py::arg("color") = "auto",
            py::arg("texture") = py::none(), py::arg("bake") = false, py::arg("height") = "none",
            py::arg("height_image") = py::none(), py::arg("height_scale") = 0.1,
+           py::arg("detail") = py::none(), py::arg("detail_scale") = 1.0,
            py::arg("progress") = py::none(),
            "Pastes the source's colour (and height) onto the target through the map and writes "
            "the files of `elastic paste` (painted OBJ/MTL and textures, colours PLY, baked and "
-           "displaced meshes when asked) into the folder `out`, all together or none. -> the "
-           "paths written.")
+           "displaced meshes when asked; detail: a mesh or path whose geometric detail over the "
+           "source is carried onto the target, as --detail) into the folder `out`, all together "
+           "or none. -> the paths written.")
+      .def("transport_vectors", &transport_vectors, py::arg("face"), py::arg("uv"),
+           py::arg("vectors"), py::arg("mode") = "stretch",
+           "Carries (N, 3) vectors at source surface points to the target by the map's "
+           "differential: 'stretch' (J v: they stretch and shear with the paste) or 'rotation' "
+           "(directions, lengths kept) -> dict 'inside' (N,) bool, 'position' and 'vectors' "
+           "(N, 3), NaN outside.")
       .def("__repr__", [](const MapState& s) {
         return "<elastic.Map " + std::to_string(s.result.sampling.grid.num_particles()) +
                " particles, " + (s.result.relaxation.converged ? "converged" : "not converged") +

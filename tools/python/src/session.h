@@ -18,6 +18,7 @@
 #include "elastic/projection/closest_point.h"
 #include "elastic/regions/region.h"
 #include "elastic/surface/limit_surface.h"
+#include "elastic/transfer/tangent_frames.h"
 
 namespace elastic::python {
 
@@ -40,6 +41,9 @@ struct MapState {
   std::shared_ptr<const RegionState> source_region, target_region;
   MapResult result;
   MapMetrics metrics, naive_metrics;  // docs/metrics.md, as `elastic map` reports them
+  /// The map's differential per grid triangle, built on first use (transport_vectors).
+  std::once_flag differential_once;
+  std::unique_ptr<MapDifferential> differential;
 };
 
 /// A progress callback for the library that calls a Python callable (or nothing) under the GIL

@@ -222,3 +222,27 @@ def test_paste_writes_the_painted_files_together(tmp_path, cap):
 def test_particle_count_out_of_range(plane, cap):
     with pytest.raises(ValueError, match="particles"):
         elastic.map_regions(plane.region("boundary"), cap.region("boundary"), particles=3)
+
+
+def test_vectors_follow_the_maps_differential(plane_cap, plane):
+    rng = np.random.default_rng(11)
+    angle = rng.uniform(0, 2 * np.pi, 40)
+    radius = rng.uniform(0.0, 0.35, 40)
+    x = np.stack([0.5 + radius * np.cos(angle), 0.5 + radius * np.sin(angle), np.zeros(40)], 1)
+    v = np.stack([np.cos(2 * angle), np.sin(2 * angle), np.zeros(40)], 1)
+    at = plane.closest(x)
+    moved = plane_cap.transport_vectors(at["face"], at["uv"], v)
+    assert moved["inside"].all()
+    # J v against a finite difference of the map along v. J is the grid triangle's (flat)
+    # Jacobian while the mapped points lie on the curved limit surface: they differ by about 0.13%
+    # here, whatever h (1e-4 .. 1e-7).
+    h = 1e-6
+    ahead = plane.closest(x + h * v)
+    f0 = plane_cap.forward(at["face"], at["uv"])["position"]
+    f1 = plane_cap.forward(ahead["face"], ahead["uv"])["position"]
+    scale = np.linalg.norm(moved["vectors"], axis=1)
+    assert np.allclose((f1 - f0) / h, moved["vectors"], atol=5e-3 * scale.max())
+    rotated = plane_cap.transport_vectors(at["face"], at["uv"], v, mode="rotation")
+    assert np.allclose(np.linalg.norm(rotated["vectors"], axis=1), 1.0, atol=1e-9)
+    with pytest.raises(ValueError, match="mode"):
+        plane_cap.transport_vectors(at["face"], at["uv"], v, mode="shear")
