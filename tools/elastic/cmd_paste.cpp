@@ -154,10 +154,7 @@ nlohmann::json heatmap_scale_json(const HeatmapOptions& scale,
 // (read by the caller), or null.
 PasteOptions paste_options(const PasteArgs& a, const PolygonMesh* detail) {
   PasteOptions o;
-  o.color = a.color == "texture"  ? PasteColor::Texture
-            : a.color == "vertex" ? PasteColor::Vertex
-            : a.color == "none"   ? PasteColor::None
-                                  : PasteColor::Auto;
+  o.color = parse_paste_color(a.color, "--color");
   o.texture = a.texture;
   o.image_read = image_read_options(a.job);
   o.resolution = a.resolution;

@@ -135,11 +135,9 @@ MapOptions make_map_options(const MapJob& job, const ProgressCallback& progress)
   options.relaxation.solver = job.solver == "explicit" ? SolverKind::Faithful : SolverKind::Fast;
   options.relaxation.energy = parse_energy_kind(job.energy, "--energy");
   options.choose_offset = job.boundary_offset == "auto";
-  // auto: slide, except with --subdivide (refinement places new boundary particles by the source
-  // parameters, so it needs the fixed correspondence).
-  options.relaxation.boundary =
-      job.boundary == "auto" ? (job.subdivide > 0 ? BoundaryMode::Fixed : BoundaryMode::Slide)
-                             : parse_boundary_mode(job.boundary, "--boundary");
+  options.relaxation.boundary = job.boundary == "auto"
+                                    ? auto_boundary_mode(job.subdivide)
+                                    : parse_boundary_mode(job.boundary, "--boundary");
   options.relaxation.lbfgs.preconditioner =
       parse_preconditioner(job.preconditioner, "--preconditioner");
   options.relaxation.threads = job.threads;

@@ -97,6 +97,13 @@ struct MapResult {
 /// The regions must lie on the projectors' surfaces and outlive the result, as must the projectors.
 /// \throws InvalidInputError for inconsistent inputs or options (naming them); NumericalError
 ///         when a stage fails numerically.
+/// The boundary mode a caller's "auto" means (`elastic map --boundary auto`, the Python binding's
+/// boundary="auto"): sliding, except with subdivision, whose refinement places the new boundary
+/// particles by their source parameters and so needs the fixed correspondence.
+inline BoundaryMode auto_boundary_mode(int subdivisions) {
+  return subdivisions > 0 ? BoundaryMode::Fixed : BoundaryMode::Slide;
+}
+
 MapResult map_regions(const SurfaceProjector& source, const Region& source_region,
                       const SurfaceProjector& target, const Region& target_region,
                       const MapOptions& options = {});

@@ -114,6 +114,15 @@ PasteDetailResult carry_detail(const SurfaceProjector& source, const LimitSurfac
 
 }  // namespace
 
+PasteColor parse_paste_color(std::string_view text, std::string_view input) {
+  if (text == "auto") return PasteColor::Auto;
+  if (text == "texture") return PasteColor::Texture;
+  if (text == "vertex") return PasteColor::Vertex;
+  if (text == "none") return PasteColor::None;
+  throw InvalidInputError(std::string(input), "expected auto, texture, vertex or none, got '" +
+                                                  std::string(text) + "'");
+}
+
 PasteResult paste(const SurfaceProjector& source, const Region& source_region,
                   const SurfaceProjector& target, const Region& target_region, const MapResult& map,
                   const PasteOptions& options) {

@@ -25,6 +25,7 @@
 #include <filesystem>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "elastic/core/progress.h"
@@ -139,6 +140,10 @@ struct PasteResult {
 /// \throws InvalidInputError when an option is out of range, a colour, texture or texture
 ///         coordinates the options ask for are missing (naming the surface), or a bake has no
 ///         colour; IoError / InvalidInputError from reading images; NumericalError from the steps.
+/// "auto", "texture", "vertex" or "none" (the CLI's --color). \throws InvalidInputError naming
+/// `input` for anything else.
+PasteColor parse_paste_color(std::string_view text, std::string_view input = "color");
+
 PasteResult paste(const SurfaceProjector& source, const Region& source_region,
                   const SurfaceProjector& target, const Region& target_region, const MapResult& map,
                   const PasteOptions& options = {});

@@ -72,6 +72,13 @@ py::object faces_array(const PolygonMesh& mesh) {
   return out;
 }
 
+// A mesh file read while Ctrl-C is watched (run_interruptible).
+std::shared_ptr<PolygonMesh> read_mesh_interruptible(const std::string& path) {
+  auto mesh = std::make_shared<PolygonMesh>();
+  run_interruptible([mesh, path] { *mesh = read_mesh(path).mesh; });
+  return mesh;
+}
+
 SubdivisionScheme parse_scheme(const std::string& scheme) {
   if (scheme == "auto") return SubdivisionScheme::Automatic;
   if (scheme == "loop") return SubdivisionScheme::Loop;
@@ -86,15 +93,16 @@ std::shared_ptr<SurfaceState> make_surface(std::shared_ptr<PolygonMesh> mesh, st
   LimitSurfaceOptions options;
   options.name = state->name;
   options.scheme = parse_scheme(scheme);
-  const py::gil_scoped_release release;
   state->mesh = std::move(mesh);
-  if (repair) {
-    sanitize_mesh(*state->mesh, state->name);
-  } else {
-    require_valid_manifold(*state->mesh, state->name);
-  }
-  state->surface = std::make_unique<LimitSurface>(*state->mesh, options);
-  state->projector = std::make_unique<SurfaceProjector>(*state->surface);
+  run_interruptible([state, options, repair] {
+    if (repair) {
+      sanitize_mesh(*state->mesh, state->name);
+    } else {
+      require_valid_manifold(*state->mesh, state->name);
+    }
+    state->surface = std::make_unique<LimitSurface>(*state->mesh, options);
+    state->projector = std::make_unique<SurfaceProjector>(*state->surface);
+  });
   return state;
 }
 
@@ -234,9 +242,10 @@ std::shared_ptr<RegionState> make_region_state(const std::shared_ptr<SurfaceStat
   }
   auto state = std::make_shared<RegionState>();
   state->surface = s;
-  const py::gil_scoped_release release;
-  state->region =
-      make_region(*s->projector, parsed, {.max_point_distance = max_point_distance, .name = name});
+  run_interruptible([state, s, parsed, max_point_distance, name] {
+    state->region = make_region(*s->projector, parsed,
+                                {.max_point_distance = max_point_distance, .name = name});
+  });
   return state;
 }
 
@@ -284,11 +293,7 @@ void bind_geometry(py::module_& m) {
       });
 
   m.def(
-      "load_mesh",
-      [](const std::string& path) {
-        const py::gil_scoped_release release;
-        return std::make_shared<PolygonMesh>(read_mesh(path).mesh);
-      },
+      "load_mesh", [](const std::string& path) { return read_mesh_interruptible(path); },
       py::arg("path"),
       "Reads an OBJ, OFF, PLY or STL file (by its extension). Raises IoError / InvalidInputError "
       "naming the file.");
@@ -310,12 +315,7 @@ void bind_geometry(py::module_& m) {
       .def(py::init([](const py::object& mesh, const std::string& scheme, bool repair) {
              if (py::isinstance<py::str>(mesh)) {
                const std::string path = mesh.cast<std::string>();
-               std::shared_ptr<PolygonMesh> read;
-               {
-                 const py::gil_scoped_release release;
-                 read = std::make_shared<PolygonMesh>(read_mesh(path).mesh);
-               }
-               return make_surface(std::move(read), path, scheme, repair);
+               return make_surface(read_mesh_interruptible(path), path, scheme, repair);
              }
              // The surface keeps its own copy: repairs never change the caller's mesh.
              return make_surface(std::make_shared<PolygonMesh>(mesh.cast<const PolygonMesh&>()),
@@ -412,23 +412,18 @@ void bind_geometry(py::module_& m) {
         if (shape != "rectangle" && shape != "ellipse") {
           throw py::value_error("shape: expected 'rectangle' or 'ellipse', got '" + shape + "'");
         }
-        ImagePlane plane;
-        {
-          const py::gil_scoped_release release;
-          plane =
-              make_image_plane(path, {.width = width,
-                                      .shape = shape == "ellipse" ? ImageRegionShape::Ellipse
-                                                                  : ImageRegionShape::Rectangle});
-        }
-        auto surface =
-            make_surface(std::make_shared<PolygonMesh>(std::move(plane.mesh)), path, "auto", true);
+        auto plane = std::make_shared<ImagePlane>();
+        const ImagePlaneOptions options{
+            .width = width,
+            .shape = shape == "ellipse" ? ImageRegionShape::Ellipse : ImageRegionShape::Rectangle};
+        run_interruptible([plane, path, options] { *plane = make_image_plane(path, options); });
+        auto surface = make_surface(std::make_shared<PolygonMesh>(plane->mesh), path, "auto", true);
         auto region = std::make_shared<RegionState>();
         region->surface = surface;
-        {
-          const py::gil_scoped_release release;
+        run_interruptible([region, surface, plane] {
           region->region =
-              make_region(*surface->projector, plane.region, {.name = "source region"});
-        }
+              make_region(*surface->projector, plane->region, {.name = "source region"});
+        });
         return py::make_tuple(surface, region);
       },
       py::arg("path"), py::arg("width") = 2.0, py::arg("shape") = "rectangle",

@@ -74,9 +74,8 @@ MapOptions map_options(const MapKeywords& k) {
   options.relaxation.solver = k.solver == "explicit" ? SolverKind::Faithful : SolverKind::Fast;
   options.relaxation.energy = parse_energy_kind(k.energy, "energy");
   options.choose_offset = k.boundary_offset == "auto";
-  options.relaxation.boundary = k.boundary == "auto"
-                                    ? (k.subdivide > 0 ? BoundaryMode::Fixed : BoundaryMode::Slide)
-                                    : parse_boundary_mode(k.boundary, "boundary");
+  options.relaxation.boundary = k.boundary == "auto" ? auto_boundary_mode(k.subdivide)
+                                                     : parse_boundary_mode(k.boundary, "boundary");
   options.relaxation.lbfgs.preconditioner =
       parse_preconditioner(k.preconditioner, "preconditioner");
   options.relaxation.threads = k.threads;
@@ -261,33 +260,21 @@ py::dict baseline(const MapState& m, const std::string& kind) {
 
 std::vector<std::string> paste_files(const MapState& m, const std::string& out,
                                      const std::string& color, const py::object& texture, bool bake,
-                                     const std::string& height, const py::object& height_image,
-                                     double height_scale, const py::object& detail,
-                                     double detail_scale, const py::object& progress) {
+                                     const py::object& height, double height_scale,
+                                     const py::object& detail, double detail_scale,
+                                     const py::object& progress) {
   PasteOptions options;
-  if (color == "auto")
-    options.color = PasteColor::Auto;
-  else if (color == "texture")
-    options.color = PasteColor::Texture;
-  else if (color == "vertex")
-    options.color = PasteColor::Vertex;
-  else if (color == "none")
-    options.color = PasteColor::None;
-  else
-    throw py::value_error("color: expected 'auto', 'texture', 'vertex' or 'none', got '" + color +
-                          "'");
-  if (height == "none")
-    options.height = PasteHeight::None;
-  else if (height == "image")
-    options.height = PasteHeight::Image;
-  else if (height == "luminance")
-    options.height = PasteHeight::Luminance;
-  else
-    throw py::value_error("height: expected 'none', 'image' or 'luminance', got '" + height + "'");
-  if (!texture.is_none()) options.texture = texture.cast<std::string>();
-  if (!height_image.is_none()) options.height_image = height_image.cast<std::string>();
-  if (options.height == PasteHeight::Image && options.height_image.empty()) {
-    throw py::value_error("height_image: needed with height='image'");
+  options.color = parse_paste_color(color, "color");
+  if (!texture.is_none()) {
+    options.texture = texture.cast<std::string>();
+  }
+  // As the CLI's --height: None, "luminance" (of the pasted colour), or a height image's path.
+  if (!height.is_none()) {
+    const std::string h = height.cast<std::string>();
+    options.height = h == "luminance" ? PasteHeight::Luminance : PasteHeight::Image;
+    if (options.height == PasteHeight::Image) {
+      options.height_image = h;
+    }
   }
   options.bake = bake;
   options.height_scale = height_scale;
@@ -535,13 +522,13 @@ void bind_map(py::module_& m) {
            "A baseline map ('lscm', 'arap' or 'dcm', CGAL) of the same grid, as `elastic compare` "
            "runs it -> dict 'positions', 'outside', 'metrics', 'seconds'.")
       .def("paste", &paste_files, py::arg("out"), py::kw_only(), py::arg("color") = "auto",
-           py::arg("texture") = py::none(), py::arg("bake") = false, py::arg("height") = "none",
-           py::arg("height_image") = py::none(), py::arg("height_scale") = 0.1,
-           py::arg("detail") = py::none(), py::arg("detail_scale") = 1.0,
-           py::arg("progress") = py::none(),
+           py::arg("texture") = py::none(), py::arg("bake") = false, py::arg("height") = py::none(),
+           py::arg("height_scale") = 0.1, py::arg("detail") = py::none(),
+           py::arg("detail_scale") = 1.0, py::arg("progress") = py::none(),
            "Pastes the source's colour (and height) onto the target through the map and writes "
            "the files of `elastic paste` (painted OBJ/MTL and textures, colours PLY, baked and "
-           "displaced meshes when asked; detail: a mesh or path whose geometric detail over the "
+           "displaced meshes when asked; height: None, 'luminance' or a height image's path, as "
+           "--height; detail: a mesh or path whose geometric detail over the "
            "source is carried onto the target, as --detail) into the folder `out`, all together "
            "or none. -> the paths written.")
       .def("transport_vectors", &transport_vectors, py::arg("face"), py::arg("uv"),

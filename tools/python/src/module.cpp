@@ -3,6 +3,10 @@
 // and pasted through it in bind_map.cpp; the Python package (tools/python/elastic) re-exports them.
 #include <pybind11/pybind11.h>
 
+#include <chrono>
+#include <condition_variable>
+#include <thread>
+
 #include "elastic/core/error.h"
 #include "session.h"
 
@@ -42,6 +46,45 @@ void PythonProgress::rethrow() {
     std::exception_ptr error = error_;
     error_ = nullptr;
     std::rethrow_exception(error);
+  }
+}
+
+void run_interruptible(std::function<void()> work) {
+  struct Shared {
+    std::mutex mutex;
+    std::condition_variable done_signal;
+    bool done = false;
+    std::exception_ptr error;
+  };
+  auto shared = std::make_shared<Shared>();
+  std::thread([shared, work = std::move(work)] {
+    std::exception_ptr error;
+    try {
+      work();
+    } catch (...) {
+      error = std::current_exception();
+    }
+    const std::lock_guard<std::mutex> lock(shared->mutex);
+    shared->error = error;
+    shared->done = true;
+    shared->done_signal.notify_all();
+  }).detach();
+  for (;;) {
+    {
+      const py::gil_scoped_release release;
+      std::unique_lock<std::mutex> lock(shared->mutex);
+      if (shared->done_signal.wait_for(lock, std::chrono::milliseconds(50),
+                                       [&] { return shared->done; })) {
+        break;
+      }
+    }
+    if (PyErr_CheckSignals() != 0) {
+      throw py::error_already_set();  // the work goes on unseen and frees what it owns
+    }
+  }
+  const std::lock_guard<std::mutex> lock(shared->mutex);
+  if (shared->error) {
+    std::rethrow_exception(shared->error);
   }
 }
 

@@ -6,6 +6,7 @@
 #include <pybind11/pybind11.h>
 
 #include <exception>
+#include <functional>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -65,6 +66,13 @@ class PythonProgress {
   std::exception_ptr error_;
   bool stopped_ = false;
 };
+
+/// Runs `work` on a thread of its own while the calling thread waits without the GIL, watching for
+/// Ctrl-C: on a pending KeyboardInterrupt the call raises it at once and the work finishes unseen
+/// in the background (so it must own what it touches, shared_ptrs captured by value, and write no
+/// file). For the long steps the library gives no progress callback: reading a mesh, building a
+/// limit surface and its search structure, building a region. Exceptions of `work` are rethrown.
+void run_interruptible(std::function<void()> work);
 
 /// Measures a placement of the map's particles on its target as `elastic map` does
 /// (docs/metrics.md): the map's rest scale, the target's normals, particles without a valid

@@ -5,6 +5,7 @@ import inspect
 import os
 import signal
 import threading
+import time
 
 import numpy as np
 import pytest
@@ -246,3 +247,30 @@ def test_vectors_follow_the_maps_differential(plane_cap, plane):
     assert np.allclose(np.linalg.norm(rotated["vectors"], axis=1), 1.0, atol=1e-9)
     with pytest.raises(ValueError, match="mode"):
         plane_cap.transport_vectors(at["face"], at["uv"], v, mode="shear")
+
+
+def test_ctrl_c_stops_building_a_surface_at_once():
+    # Building a limit surface has no progress callback: it runs on a thread of its own while
+    # the call watches for Ctrl-C, and raises KeyboardInterrupt without waiting for it.
+    head = str(MESHES / "nefertiti-lowres.obj")
+    start = time.monotonic()
+    elastic.Surface(head)
+    alone = time.monotonic() - start
+    timer = threading.Timer(0.05, lambda: os.kill(os.getpid(), signal.SIGINT))
+    start = time.monotonic()
+    timer.start()
+    with pytest.raises(KeyboardInterrupt):
+        elastic.Surface(head)
+    assert time.monotonic() - start < 0.05 + 0.5 < alone, alone
+
+
+def test_paste_with_luminance_height_writes_the_displaced_mesh(tmp_path, cap):
+    source, region = elastic.image_source(str(MESHES / "pmp_logo_512.png"), shape="ellipse")
+    m = elastic.map_regions(region, cap.region("boundary"), particles=600)
+    files = m.paste(str(tmp_path / "relief"), height="luminance", height_scale=0.05)
+    names = {os.path.basename(f) for f in files}
+    assert "displaced.obj" in names, names
+    displaced = elastic.load_mesh(str(tmp_path / "relief" / "displaced.obj"))
+    painted = elastic.load_mesh(str(tmp_path / "relief" / "painted.obj"))
+    moved = np.abs(displaced.vertices - painted.vertices).max()
+    assert 0 < moved <= 0.05 + 1e-9
