@@ -44,7 +44,8 @@ std::vector<Eigen::Vector3d> spiral(long n) {
   for (long i = 0; i < n; ++i) {
     const double r = 0.44 * std::sqrt((static_cast<double>(i) + 0.5) / static_cast<double>(n));
     const double theta = golden * static_cast<double>(i);
-    points[static_cast<std::size_t>(i)] = {0.5 + r * std::cos(theta), 0.5 + r * std::sin(theta), 0.0};
+    points[static_cast<std::size_t>(i)] = {0.5 + r * std::cos(theta), 0.5 + r * std::sin(theta),
+                                           0.0};
   }
   return points;
 }
@@ -61,7 +62,9 @@ void ForwardMillion(benchmark::State& state) {
   std::vector<ClosestPoint> found(xs.size());
   plane.projector->closest(xs, found);
   std::vector<SurfacePoint> points(found.size());
-  for (std::size_t i = 0; i < found.size(); ++i) points[i] = found[i].point;
+  for (std::size_t i = 0; i < found.size(); ++i) {
+    points[i] = found[i].point;
+  }
   std::vector<Mapping::Location> out(points.size());
   for (auto _ : state) {
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, points.size(), 1024),
@@ -73,7 +76,9 @@ void ForwardMillion(benchmark::State& state) {
     benchmark::DoNotOptimize(out.data());
   }
   long inside = 0;
-  for (const auto& l : out) inside += l.inside ? 1 : 0;
+  for (const auto& l : out) {
+    inside += l.inside ? 1 : 0;
+  }
   state.counters["inside"] = static_cast<double>(inside);
 }
 BENCHMARK(ForwardMillion)->Arg(1'000'000)->Unit(benchmark::kMillisecond)->UseRealTime();

@@ -228,7 +228,8 @@ using UvMap = Mesh::Property_map<VertexIndex, Point2>;
 
 // CGAL's parameterizer of `kind` into uvmap; s: the boundary vertices' parameters.
 void parameterize(Mesh& mesh, const Region& region, const std::vector<double>& s, BaselineKind kind,
-                  const DiskBorder& border, const CgalFlatteningOptions& options, UvMap uvmap) {
+                  const DiskBorder& border, const CgalFlatteningOptions& options,
+                  const UvMap& uvmap) {
   const std::string& name = options.name;
   SMP::Error_code status = SMP::OK;
   switch (kind) {

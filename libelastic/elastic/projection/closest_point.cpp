@@ -199,8 +199,8 @@ struct SurfaceProjector::Impl {
     const auto& nodes = corner_nodes[static_cast<size_t>(triangle)];
     const double n = face_resolution[static_cast<size_t>(
         tessellation.triangle_face[static_cast<size_t>(triangle)])];
-    return {nodes[static_cast<size_t>(2 * corner)] / n,
-            nodes[static_cast<size_t>(2 * corner + 1)] / n};
+    return {nodes[2 * static_cast<size_t>(corner)] / n,
+            nodes[2 * static_cast<size_t>(corner) + 1] / n};
   }
   SurfacePoint seed(int triangle, double w1, double w2) const;
 
@@ -295,8 +295,8 @@ void SurfaceProjector::Impl::build_corner_nodes() {
               }
             }
           }
-          corner_nodes[tri][static_cast<size_t>(2 * c)] = static_cast<std::uint16_t>(i);
-          corner_nodes[tri][static_cast<size_t>(2 * c + 1)] = static_cast<std::uint16_t>(j);
+          corner_nodes[tri][2 * static_cast<size_t>(c)] = static_cast<std::uint16_t>(i);
+          corner_nodes[tri][2 * static_cast<size_t>(c) + 1] = static_cast<std::uint16_t>(j);
         }
       }
     }

@@ -115,10 +115,13 @@ PasteDetailResult carry_detail(const SurfaceProjector& source, const LimitSurfac
 }  // namespace
 
 PasteColor parse_paste_color(std::string_view text, std::string_view input) {
-  if (text == "auto") return PasteColor::Auto;
-  if (text == "texture") return PasteColor::Texture;
-  if (text == "vertex") return PasteColor::Vertex;
-  if (text == "none") return PasteColor::None;
+  for (const auto& [name, kind] :
+       {std::pair{"auto", PasteColor::Auto}, std::pair{"texture", PasteColor::Texture},
+        std::pair{"vertex", PasteColor::Vertex}, std::pair{"none", PasteColor::None}}) {
+    if (text == name) {
+      return kind;
+    }
+  }
   throw InvalidInputError(std::string(input), "expected auto, texture, vertex or none, got '" +
                                                   std::string(text) + "'");
 }

@@ -80,9 +80,15 @@ std::shared_ptr<PolygonMesh> read_mesh_interruptible(const std::string& path) {
 }
 
 SubdivisionScheme parse_scheme(const std::string& scheme) {
-  if (scheme == "auto") return SubdivisionScheme::Automatic;
-  if (scheme == "loop") return SubdivisionScheme::Loop;
-  if (scheme == "catmull-clark") return SubdivisionScheme::CatmullClark;
+  if (scheme == "auto") {
+    return SubdivisionScheme::Automatic;
+  }
+  if (scheme == "loop") {
+    return SubdivisionScheme::Loop;
+  }
+  if (scheme == "catmull-clark") {
+    return SubdivisionScheme::CatmullClark;
+  }
   throw py::value_error("scheme: expected 'auto', 'loop' or 'catmull-clark', got '" + scheme + "'");
 }
 
@@ -121,7 +127,9 @@ template <typename Body>
 void parallel(std::size_t n, const Body& body) {
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 256),
                     [&](const tbb::blocked_range<std::size_t>& r) {
-                      for (std::size_t i = r.begin(); i != r.end(); ++i) body(i);
+                      for (std::size_t i = r.begin(); i != r.end(); ++i) {
+                        body(i);
+                      }
                     });
 }
 
@@ -408,7 +416,11 @@ void bind_geometry(py::module_& m) {
 
   m.def(
       "image_source",
-      [](const std::string& path, double width, const std::string& shape) {
+      [](const std::string& path, double width, const std::string& shape, std::int64_t max_pixels) {
+        if (max_pixels <= 0) {
+          throw py::value_error("max_pixels: expected a positive count, got " +
+                                std::to_string(max_pixels));
+        }
         if (shape != "rectangle" && shape != "ellipse") {
           throw py::value_error("shape: expected 'rectangle' or 'ellipse', got '" + shape + "'");
         }
@@ -416,7 +428,9 @@ void bind_geometry(py::module_& m) {
         const ImagePlaneOptions options{
             .width = width,
             .shape = shape == "ellipse" ? ImageRegionShape::Ellipse : ImageRegionShape::Rectangle};
-        run_interruptible([plane, path, options] { *plane = make_image_plane(path, options); });
+        const ImageReadOptions read{.max_pixels = max_pixels, .limit_name = "max_pixels"};
+        run_interruptible(
+            [plane, path, options, read] { *plane = make_image_plane(path, options, read); });
         auto surface = make_surface(std::make_shared<PolygonMesh>(plane->mesh), path, "auto", true);
         auto region = std::make_shared<RegionState>();
         region->surface = surface;
@@ -427,8 +441,11 @@ void bind_geometry(py::module_& m) {
         return py::make_tuple(surface, region);
       },
       py::arg("path"), py::arg("width") = 2.0, py::arg("shape") = "rectangle",
+      py::arg("max_pixels") = kDefaultMaxImagePixels,
       "A source made from an image (as the CLI's --source-image): the plane carrying it, `width` "
-      "wide, and its region ('rectangle' or the inscribed 'ellipse') -> (Surface, Region).");
+      "wide (--image-width), and its region ('rectangle' or the inscribed 'ellipse') -> (Surface, "
+      "Region). Images of more than max_pixels pixels (--max-image-pixels) are refused from their "
+      "header, before decoding.");
 }
 
 }  // namespace elastic::python

@@ -332,7 +332,9 @@ MapMetrics measure_on_target(const MapState& map, const Eigen::Matrix3Xd& positi
   options.rest_scale = map.result.rest_scale;
   outside.resize(points.size(), 0);
   for (std::size_t p = 0; p < points.size(); ++p) {
-    if (!points[p].valid()) outside[p] = 1;
+    if (!points[p].valid()) {
+      outside[p] = 1;
+    }
   }
   options.target_normals = surface_normals(*map.target->surface, points, outside);
   options.outside = std::move(outside);
@@ -452,7 +454,9 @@ void bind_map(py::module_& m) {
             auto rows = out.mutable_unchecked<2>();
             for (int i = 0; i < g.num_particles(); ++i) {
               const auto& p = g.mesh.point(GridMesh::VertexHandle(i));
-              for (int c = 0; c < 3; ++c) rows(i, c) = p[c];
+              for (int c = 0; c < 3; ++c) {
+                rows(i, c) = p[c];
+              }
             }
             return out;
           },

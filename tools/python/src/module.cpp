@@ -112,6 +112,8 @@ void bind_exceptions(py::module_& m) {
             "A file could not be opened, read or written.");
   numerical = make("NumericalError", py::make_tuple(base, py::handle(PyExc_ArithmeticError)),
                    "A numerical computation failed on valid input.");
+  // pybind11's translator type takes the exception_ptr by value.
+  // NOLINTNEXTLINE(performance-unnecessary-value-param)
   py::register_exception_translator([](std::exception_ptr error) {
     try {
       if (error) {

@@ -107,3 +107,18 @@ def test_command_line_usage_error():
     with pytest.raises(SystemExit) as e:
         batch.main(["--workers", "0", "job.json"])
     assert e.value.code == 2
+
+
+def test_the_command_line_runs_on_a_scheduler_by_address(tmp_path):
+    job = map_job(tmp_path / "one.json", particles=400)
+    bad = tmp_path / "bad.json"
+    bad.write_text("[]")
+    out = tmp_path / "out"
+    with distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=True,
+                                  host="127.0.0.1", dashboard_address=None) as cluster:
+        code = batch.main([job, str(bad), "--scheduler", cluster.scheduler_address,
+                           "--out", str(out), "-q"])
+    assert code == 1  # one job failed
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["ok"] == 1 and summary["jobs"][1]["exit"] == 64
+    assert summary["scheduler"] == cluster.scheduler_address

@@ -274,3 +274,8 @@ def test_paste_with_luminance_height_writes_the_displaced_mesh(tmp_path, cap):
     painted = elastic.load_mesh(str(tmp_path / "relief" / "painted.obj"))
     moved = np.abs(displaced.vertices - painted.vertices).max()
     assert 0 < moved <= 0.05 + 1e-9
+
+
+def test_an_image_beyond_max_pixels_is_refused_by_name():
+    with pytest.raises(elastic.InvalidInputError, match="max_pixels"):
+        elastic.image_source(str(MESHES / "pmp_logo_512.png"), max_pixels=512 * 511)
