@@ -2,6 +2,7 @@
 // code.
 
 #include <signal.h>
+#include <tbb/global_control.h>
 
 #include <cstdio>
 #include <exception>
@@ -133,6 +134,17 @@ int main(int argc, char** argv) {
       CLI::App* leaf = chosen;
       while (!leaf->get_subcommands().empty()) leaf = leaf->get_subcommands().front();
       apply_job_file(*leaf);
+      // --threads N bounds every stage of the run (sampling, naive map, solver, transfer,
+      // rendering), not only the stage that reads the flag: a batch of runs side by side
+      // (python3 -m elastic.batch) then shares the cores as asked.
+      if (const CLI::Option* threads = leaf->get_option_no_throw("--threads")) {
+        const int n = threads->as<int>();
+        if (n > 0) {
+          const tbb::global_control limit(tbb::global_control::max_allowed_parallelism,
+                                          static_cast<std::size_t>(n));
+          return run ? run() : kUsage;
+        }
+      }
     }
     return run ? run() : kUsage;
   } catch (const UsageError& e) {
