@@ -28,30 +28,51 @@ py::array positions_view(const std::shared_ptr<PolygonMesh>& mesh, const py::obj
   return view;
 }
 
+// Adds one face after checking its size and vertex indices.
+void add_checked_face(PolygonMesh& mesh, const std::vector<int>& face, py::ssize_t i) {
+  if (face.size() < 3) {
+    throw py::value_error("faces: face " + std::to_string(i) + " has " +
+                          std::to_string(face.size()) + " corners, fewer than 3");
+  }
+  for (const int index : face) {
+    if (index < 0 || index >= mesh.num_vertices()) {
+      throw py::value_error("faces: vertex index " + std::to_string(index) + " of face " +
+                            std::to_string(i) + " is out of range [0, " +
+                            std::to_string(mesh.num_vertices()) + ")");
+    }
+  }
+  mesh.add_face(face);
+}
+
+// A mesh from (V, 3) positions and faces: an (F, k) integer array, or a sequence of faces of any
+// sizes (mixed polygons).
 std::shared_ptr<PolygonMesh> mesh_from_arrays(const py::handle& vertices, const py::handle& faces) {
   const Float64Array v = float_rows(vertices, "vertices", 3);
   auto mesh = std::make_shared<PolygonMesh>();
   const auto span = as_vectors(v);
   mesh->positions.assign(span.begin(), span.end());
   const py::array array = py::array::ensure(faces);
-  if (!array || array.ndim() != 2 || array.shape(1) < 3) {
-    throw py::value_error("faces: expected an integer array of shape (F, k), k >= 3, got " +
-                          (array ? "shape " + shape_text(array) : std::string("no array")));
-  }
-  const Int32Array f = int_rows(array, "faces", static_cast<int>(array.shape(1)));
-  const auto rows = f.unchecked<2>();
-  std::vector<int> face(static_cast<std::size_t>(f.shape(1)));
-  for (py::ssize_t i = 0; i < f.shape(0); ++i) {
-    for (py::ssize_t k = 0; k < f.shape(1); ++k) {
-      const int index = rows(i, k);
-      if (index < 0 || index >= mesh->num_vertices()) {
-        throw py::value_error("faces: vertex index " + std::to_string(index) + " of face " +
-                              std::to_string(i) + " is out of range [0, " +
-                              std::to_string(mesh->num_vertices()) + ")");
+  if (array && array.ndim() == 2) {
+    const Int32Array f = int_rows(array, "faces", static_cast<int>(array.shape(1)));
+    const auto rows = f.unchecked<2>();
+    std::vector<int> face(static_cast<std::size_t>(f.shape(1)));
+    for (py::ssize_t i = 0; i < f.shape(0); ++i) {
+      for (py::ssize_t k = 0; k < f.shape(1); ++k) {
+        face[static_cast<std::size_t>(k)] = rows(i, k);
       }
-      face[static_cast<std::size_t>(k)] = index;
+      add_checked_face(*mesh, face, i);
     }
-    mesh->add_face(face);
+    return mesh;
+  }
+  if (!py::isinstance<py::sequence>(faces) || py::isinstance<py::str>(faces)) {
+    throw py::value_error(
+        "faces: expected an integer array of shape (F, k), k >= 3, or a "
+        "sequence of faces");
+  }
+  py::ssize_t i = 0;
+  for (const py::handle item : faces) {
+    const Int32Array f = int_rows(item, "faces", 0);
+    add_checked_face(*mesh, std::vector<int>(f.data(), f.data() + f.shape(0)), i++);
   }
   return mesh;
 }
@@ -267,7 +288,7 @@ void bind_geometry(py::module_& m) {
       "face_vertices).")
       .def(py::init(&mesh_from_arrays), py::arg("vertices"), py::arg("faces"),
            "A mesh from a (V, 3) float64 array of positions and an (F, k) integer array of "
-           "counter-clockwise faces (k >= 3).")
+           "counter-clockwise faces (k >= 3), or a sequence of faces of any sizes.")
       .def_property_readonly(
           "vertices",
           [](const std::shared_ptr<PolygonMesh>& self) {

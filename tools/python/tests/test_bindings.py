@@ -280,3 +280,15 @@ def test_paste_with_luminance_height_writes_the_displaced_mesh(tmp_path, cap):
 def test_an_image_beyond_max_pixels_is_refused_by_name():
     with pytest.raises(elastic.InvalidInputError, match="max_pixels"):
         elastic.image_source(str(MESHES / "pmp_logo_512.png"), max_pixels=512 * 511)
+
+
+def test_a_mesh_of_mixed_polygons_from_a_list(tmp_path):
+    vertices = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0], [2, 0.5, 0]], dtype=float)
+    mesh = elastic.Mesh(vertices, [[0, 1, 2, 3], [1, 4, 2]])
+    assert mesh.faces is None  # mixed sizes
+    assert np.array_equal(mesh.face_offsets, [0, 4, 7])
+    assert np.array_equal(mesh.face_vertices, [0, 1, 2, 3, 1, 4, 2])
+    with pytest.raises(ValueError, match="face 1 has 2 corners"):
+        elastic.Mesh(vertices, [[0, 1, 2], [1, 2]])
+    with pytest.raises(ValueError, match="faces"):
+        elastic.Mesh(vertices, "0 1 2")
