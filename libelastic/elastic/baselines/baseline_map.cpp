@@ -499,8 +499,8 @@ BaselineResult map_baseline(const ParticleGrid& grid, const SurfaceProjector& so
   const BoundaryParametrisation source_boundary(source_region, "source region");
   const BoundaryParametrisation target_boundary(target_region, "target region",
                                                 options.target_offset);
-  const Similarity similarity = align_boundaries(source_boundary, from.uv, target_boundary, to.uv,
-                                                 options.alignment_samples);
+  const Similarity similarity =
+      align_boundaries(source_boundary, from.uv, target_boundary, to.uv, options.alignment_samples);
   result.alignment_scale = std::abs(similarity.a);
   result.alignment_rotation = std::arg(similarity.a);
   result.alignment_translation = {similarity.b.real(), similarity.b.imag()};
