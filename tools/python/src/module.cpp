@@ -49,6 +49,31 @@ void PythonProgress::rethrow() {
   }
 }
 
+namespace {
+
+// Works of run_interruptible still running (a Ctrl-C left them behind). The interpreter's exit
+// waits for them (wait_for_abandoned_works, registered with atexit): a work that outlived the
+// interpreter would free its surfaces after the libraries' statics are gone.
+struct RunningWorks {
+  std::mutex mutex;
+  std::condition_variable none_left;
+  int count = 0;
+};
+
+RunningWorks& running_works() {
+  static auto* works = new RunningWorks();  // never destroyed: threads may still use it at exit
+  return *works;
+}
+
+void wait_for_abandoned_works() {
+  const py::gil_scoped_release release;
+  RunningWorks& works = running_works();
+  std::unique_lock<std::mutex> lock(works.mutex);
+  works.none_left.wait(lock, [&] { return works.count == 0; });
+}
+
+}  // namespace
+
 void run_interruptible(std::function<void()> work) {
   struct Shared {
     std::mutex mutex;
@@ -57,18 +82,32 @@ void run_interruptible(std::function<void()> work) {
     std::exception_ptr error;
   };
   auto shared = std::make_shared<Shared>();
-  std::thread([shared, work = std::move(work)] {
+  {
+    const std::lock_guard<std::mutex> lock(running_works().mutex);
+    ++running_works().count;
+  }
+  std::thread worker([shared, job = std::move(work)]() mutable {
     std::exception_ptr error;
     try {
-      work();
+      job();
     } catch (...) {
       error = std::current_exception();
     }
-    const std::lock_guard<std::mutex> lock(shared->mutex);
-    shared->error = error;
-    shared->done = true;
-    shared->done_signal.notify_all();
-  }).detach();
+    // What the work holds (surfaces, Embree scenes) is released here, before the caller hears it
+    // is done: released later, by a thread nobody waits for, it could outlive the interpreter
+    // and the libraries' own statics (an Embree mutex at exit aborted the process).
+    job = nullptr;
+    {
+      const std::lock_guard<std::mutex> lock(shared->mutex);
+      shared->error = error;
+      shared->done = true;
+      shared->done_signal.notify_all();
+    }
+    RunningWorks& works = running_works();
+    const std::lock_guard<std::mutex> lock(works.mutex);
+    --works.count;
+    works.none_left.notify_all();
+  });
   for (;;) {
     {
       const py::gil_scoped_release release;
@@ -79,10 +118,14 @@ void run_interruptible(std::function<void()> work) {
       }
     }
     if (PyErr_CheckSignals() != 0) {
-      throw py::error_already_set();  // the work goes on unseen and frees what it owns
+      worker.detach();  // the work goes on unseen and frees what it owns
+      throw py::error_already_set();
     }
   }
-  const std::lock_guard<std::mutex> lock(shared->mutex);
+  {
+    const py::gil_scoped_release release;
+    worker.join();
+  }
   if (shared->error) {
     std::rethrow_exception(shared->error);
   }
@@ -142,4 +185,6 @@ PYBIND11_MODULE(_elastic, m) {
   elastic::python::bind_exceptions(m);
   elastic::python::bind_geometry(m);
   elastic::python::bind_map(m);
+  pybind11::module_::import("atexit").attr("register")(
+      pybind11::cpp_function(&elastic::python::wait_for_abandoned_works));
 }
