@@ -381,7 +381,8 @@ std::function<int()> add_robustness_subcommand(CLI::App& bench) {
   sub->add_option("--root", a->root, "Folder the cases' paths are relative to");
   sub->add_option("--report", a->report, "Write the JSON report here (cases with `pass`)");
   sub->add_option("--markdown", a->markdown, "Also write the Markdown table here");
-  sub->add_option("--threads", a->threads, "Solver threads (0: all)")->check(CLI::Range(0, 1024));
+  sub->add_option("--threads", a->threads, "Threads of every stage (0: all)")
+      ->check(CLI::Range(0, 1024));
   sub->add_option("--only", a->only, "Run only the case with this name");
   sub->add_flag("--quiet,-q", a->quiet, "No progress lines on stderr");
   sub->footer(

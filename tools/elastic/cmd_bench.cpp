@@ -395,7 +395,7 @@ ELASTIC_COMMAND("bench",
                                      "Write the Markdown results page here (default: stdout)");
                   table1->add_option("--runs", a->runs, "Runs per case (median seconds)")
                       ->check(CLI::Range(1, 100));
-                  table1->add_option("--threads", a->threads, "Solver threads (0: all)")
+                  table1->add_option("--threads", a->threads, "Threads of every stage (0: all)")
                       ->check(CLI::Range(0, 1024));
                   table1->add_option("--only", a->only, "Run only the case with this name");
                   table1->add_flag("--extra", a->extra,

@@ -8,6 +8,7 @@
 #include <exception>
 #include <iostream>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "command.h"
@@ -128,6 +129,7 @@ int main(int argc, char** argv) {
     return kUsage;
   }
 
+  std::optional<tbb::global_control> limit;
   try {
     if (chosen != nullptr) {
       // The job file belongs to the innermost subcommand given (`bench table1 --job F`).
@@ -137,13 +139,9 @@ int main(int argc, char** argv) {
       // --threads N bounds every stage of the run (sampling, naive map, solver, transfer,
       // rendering), not only the stage that reads the flag: a batch of runs side by side
       // (python3 -m elastic.batch) then shares the cores as asked.
-      if (const CLI::Option* threads = leaf->get_option_no_throw("--threads")) {
-        const int n = threads->as<int>();
-        if (n > 0) {
-          const tbb::global_control limit(tbb::global_control::max_allowed_parallelism,
-                                          static_cast<std::size_t>(n));
-          return run ? run() : kUsage;
-        }
+      if (const CLI::Option* threads = leaf->get_option_no_throw("--threads");
+          threads != nullptr && threads->as<int>() > 0) {
+        limit.emplace(tbb::global_control::max_allowed_parallelism, threads->as<std::size_t>());
       }
     }
     return run ? run() : kUsage;

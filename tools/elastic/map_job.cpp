@@ -341,17 +341,8 @@ nlohmann::json map_report(const MapJob& job, const MapSession& session,
 
 MapMetrics measure_placement(const MapSession& session, const Eigen::Matrix3Xd& positions,
                              const std::vector<SurfacePoint>& points, std::vector<char> outside) {
-  MapMetricsOptions options;
-  options.rest_scale = session.result.rest_scale;
-  // A particle without a valid target surface point has no normal and no defined place: it is
-  // treated as outside (the baselines flag theirs; the others have none in practice).
-  outside.resize(points.size(), 0);
-  for (size_t p = 0; p < points.size(); ++p) {
-    if (!points[p].valid()) outside[p] = 1;
-  }
-  options.target_normals = surface_normals(*session.target.surface, points, outside);
-  options.outside = std::move(outside);
-  return measure_map(session.result.sampling.grid, positions, options);
+  return measure_on_target(session.result.sampling.grid, *session.target.surface,
+                           session.result.rest_scale, positions, points, std::move(outside));
 }
 
 void write_report(const std::string& path, const nlohmann::json& report) {

@@ -483,4 +483,22 @@ Eigen::Matrix3Xd surface_normals(const LimitSurface& surface,
   return normals;
 }
 
+MapMetrics measure_on_target(const ParticleGrid& grid, const LimitSurface& target,
+                             double rest_scale, const Eigen::Matrix3Xd& positions,
+                             const std::vector<SurfacePoint>& points, std::vector<char> outside) {
+  MapMetricsOptions options;
+  options.rest_scale = rest_scale;
+  // A particle without a valid target surface point has no normal and no defined place: it is
+  // treated as outside (the baselines flag theirs; the others have none in practice).
+  outside.resize(points.size(), 0);
+  for (std::size_t p = 0; p < points.size(); ++p) {
+    if (!points[p].valid()) {
+      outside[p] = 1;
+    }
+  }
+  options.target_normals = surface_normals(target, points, outside);
+  options.outside = std::move(outside);
+  return measure_map(grid, positions, options);
+}
+
 }  // namespace elastic

@@ -170,4 +170,13 @@ Eigen::Matrix3Xd surface_normals(const LimitSurface& surface,
                                  const std::vector<SurfacePoint>& points,
                                  const std::vector<char>& skip = {});
 
+/// Measures a placement of `grid`'s particles on `target` the way every report does
+/// (docs/metrics.md): measure_map with `rest_scale` and the target's limit-surface normals at
+/// `points`; particles flagged in `outside` (may be empty) or without a valid surface point are
+/// left out. \throws as measure_map.
+MapMetrics measure_on_target(const ParticleGrid& grid, const LimitSurface& target,
+                             double rest_scale, const Eigen::Matrix3Xd& positions,
+                             const std::vector<SurfacePoint>& points,
+                             std::vector<char> outside = {});
+
 }  // namespace elastic

@@ -194,14 +194,15 @@ def run_batch(
         if on_done is not None:
             on_done(verdict)
     ordered = [verdicts[j] for j in jobs]
+    info = client.scheduler_info()
     return {
         "jobs": ordered,
         "total": len(ordered),
         "ok": sum(1 for v in ordered if v["ok"]),
         "failed": sum(1 for v in ordered if not v["ok"]),
         "seconds": time.monotonic() - start,
-        "scheduler": getattr(client, "scheduler_info", lambda: {})().get("address"),
-        "workers": len(getattr(client, "scheduler_info", lambda: {})().get("workers", {})),
+        "scheduler": info.get("address"),
+        "workers": len(info.get("workers", {})),
     }
 
 

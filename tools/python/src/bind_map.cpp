@@ -328,17 +328,8 @@ std::vector<std::string> paste_files(const MapState& m, const std::string& out,
 
 MapMetrics measure_on_target(const MapState& map, const Eigen::Matrix3Xd& positions,
                              const std::vector<SurfacePoint>& points, std::vector<char> outside) {
-  MapMetricsOptions options;
-  options.rest_scale = map.result.rest_scale;
-  outside.resize(points.size(), 0);
-  for (std::size_t p = 0; p < points.size(); ++p) {
-    if (!points[p].valid()) {
-      outside[p] = 1;
-    }
-  }
-  options.target_normals = surface_normals(*map.target->surface, points, outside);
-  options.outside = std::move(outside);
-  return measure_map(map.result.sampling.grid, positions, options);
+  return elastic::measure_on_target(map.result.sampling.grid, *map.target->surface,
+                                    map.result.rest_scale, positions, points, std::move(outside));
 }
 
 py::dict metrics_dict(const MapMetrics& m) {
