@@ -18,6 +18,10 @@ using Traits = CGAL::Surface_mesh_shortest_path_traits<Kernel, Mesh>;
 using ShortestPath = CGAL::Surface_mesh_shortest_path<Traits>;
 using VertexIndex = Mesh::Vertex_index;
 using FaceIndex = Mesh::Face_index;
+
+/// How far (in barycentric terms) a path's end point is moved into its triangle for CGAL
+/// (Impl::cgal_bary).
+constexpr double kInside = 1e-9;
 using HalfedgeIndex = Mesh::Halfedge_index;
 
 /// A point of the path as weights on at most three mesh vertices (an edge point has two, a
@@ -84,6 +88,14 @@ struct ExactGeodesics::Impl {
   ShortestPath::Barycentric_coordinates cgal_bary(const MeshLocation& p) const {
     // CGAL's coordinate k weighs source(next^k(halfedge(f))) (its triangle_from_halfedge), a
     // cycle that need not start at our corner 0.
+    //
+    // The point is moved kInside (relative) towards the triangle's centre: CGAL 5.5 (Debian 12's)
+    // grows wrong cones from a point exactly on an edge (CGAL issue 6681, fixed in 5.6 by
+    // PR 6739) and may root a point exactly on a vertex at another vertex (issue 9646). A corner
+    // of a points: polygon on an edge of the tessellation made the whole side aim at a point one
+    // triangle away: a square's side on grid.off ran straight to 0.0112 beside its far corner
+    // and turned there. The path's end points are taken as given (path()), so only the
+    // crossings in between see the shift, of kInside times the triangle's size.
     const FaceIndex f(static_cast<Mesh::size_type>(face_of[static_cast<size_t>(p.triangle)]));
     std::array<double, 3> b{0.0, 0.0, 0.0};
     HalfedgeIndex h = mesh.halfedge(f);
@@ -96,7 +108,8 @@ struct ExactGeodesics::Impl {
       }
       h = mesh.next(h);
     }
-    return {b[0], b[1], b[2]};
+    const double n = 1.0 - 3.0 * kInside;
+    return {n * b[0] + kInside, n * b[1] + kInside, n * b[2] + kInside};
   }
 
   Weights weights_of(const MeshLocation& p) const {
