@@ -28,6 +28,7 @@ struct SampleArgs {
   int iterations = AdaptiveSamplingOptions{}.max_iterations;
   double floor = AdaptiveSamplingOptions{}.floor;
   double max_weight = AdaptiveSamplingOptions{}.max_weight;
+  double curvature_radius = AdaptiveSamplingOptions{}.curvature_radius;
   bool adaptive = true;
   bool fixed_boundary = false;
   std::string flattening = "conformal";
@@ -63,6 +64,7 @@ int run_sample(const SampleArgs& args, const CLI::App& sub) {
   options.sampling.max_iterations = args.iterations;
   options.sampling.floor = args.floor;
   options.sampling.max_weight = args.max_weight;
+  options.sampling.curvature_radius = args.curvature_radius;
   options.sampling.move_boundary = !args.fixed_boundary;
   options.sampling.progress = terminal_progress(args.quiet);
   const SampleRegionResult sampled = sample_region(region, *loaded.projector, options);
@@ -103,6 +105,7 @@ int run_sample(const SampleArgs& args, const CLI::App& sub) {
         {"newton_steps", sampled.sampling.newton_steps},
         {"cg_iterations", sampled.sampling.cg_iterations},
         {"converged", sampled.sampling.converged},
+        {"stalled", sampled.sampling.stalled},
         {"last_max_move", sampled.sampling.max_move},
         {"rejected_moves", sampled.sampling.rejected_moves},
         {"mean_curvature_weight", sampled.sampling.mean_curvature_weight},
@@ -122,8 +125,10 @@ int run_sample(const SampleArgs& args, const CLI::App& sub) {
             << st.spacing_max << "; density ratio high/low curvature " << st.density_ratio << '\n';
   if (args.adaptive) {
     std::cout << "adaptive sampling: " << sampled.sampling.iterations << " iterations, "
-              << (sampled.sampling.converged ? "converged" : "not converged") << " (last move "
-              << sampled.sampling.max_move << " of the mean spacing)\n";
+              << (sampled.sampling.converged ? "converged"
+                  : sampled.sampling.stalled ? "not converged, stalled"
+                                             : "not converged")
+              << " (last move " << sampled.sampling.max_move << " of the mean spacing)\n";
   }
   if (!args.out.empty()) std::cout << "wrote " << args.out << '\n';
   return kOk;
@@ -152,6 +157,10 @@ ELASTIC_COMMAND("sample", "Sample a source region with the particle grid", [](CL
   sub.add_option("--max-weight", args->max_weight,
                  "Clamp curvature weights at this multiple of their mean (0: no clamp)")
       ->check(CLI::Range(0.0, 1e6));
+  sub.add_option("--curvature-radius", args->curvature_radius,
+                 "Average the curvature over about this many grid spacings (a kernel as wide as a "
+                 "Gaussian of this standard deviation; 0: pointwise, the paper's)")
+      ->check(CLI::Range(0.0, 100.0));
   sub.add_flag("!--no-adaptive", args->adaptive,
                "Keep the regular layout (no curvature adaptation)");
   sub.add_flag("--fixed-boundary", args->fixed_boundary,

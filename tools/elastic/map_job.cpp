@@ -115,6 +115,11 @@ void add_map_flags(CLI::App& sub, MapJob& a) {
                  "spacing (0: none, the sampling is deterministic)")
       ->check(CLI::Range(0.0, 0.5));
   sub.add_option("--seed", a.seed, "Seed of the --jitter (the same seed repeats a run exactly)");
+  sub.add_option("--curvature-radius", a.curvature_radius,
+                 "The adaptive sampling's curvature averaged over about this many grid spacings "
+                 "(a kernel as wide as a Gaussian of this standard deviation; 0: pointwise, the "
+                 "paper's and Table 1's)")
+      ->check(CLI::Range(0.0, 100.0));
   sub.add_option("--max-iterations", a.max_iterations, "Solver iteration budget (0: default)")
       ->check(CLI::NonNegativeNumber);
   sub.add_option("--max-memory", a.max_memory_mb,
@@ -131,6 +136,7 @@ MapOptions make_map_options(const MapJob& job, const ProgressCallback& progress)
   options.sampling.layout.name = "--source-region";
   options.sampling.sampling.seed = job.seed;
   options.sampling.sampling.jitter = job.jitter;
+  options.sampling.sampling.curvature_radius = job.curvature_radius;
   options.rest_scale = parse_rest_scale(job.rest_scale, "--rest-scale");
   options.relaxation.solver = job.solver == "explicit" ? SolverKind::Faithful : SolverKind::Fast;
   options.relaxation.energy = parse_energy_kind(job.energy, "--energy");

@@ -46,10 +46,12 @@ struct MapJob {
   int subdivide = 0;                         ///< --subdivide K: refinement levels after the map
   int threads = 0;                           ///< --threads N (0: all)
   double jitter = 0.0;                       ///< --jitter F: random start of the sampling
-  unsigned long seed = 0;                    ///< --seed S: seed of the --jitter
-  long max_iterations = 0;                   ///< --max-iterations (0: the solver's default)
-  std::string report;                        ///< --report FILE
-  bool quiet = false;                        ///< --quiet
+  /// --curvature-radius S: the sampling's curvature averaged over S grid spacings (0: pointwise)
+  double curvature_radius = AdaptiveSamplingOptions{}.curvature_radius;
+  unsigned long seed = 0;   ///< --seed S: seed of the --jitter
+  long max_iterations = 0;  ///< --max-iterations (0: the solver's default)
+  std::string report;       ///< --report FILE
+  bool quiet = false;       ///< --quiet
 
   /// --max-memory MB: the most memory the run may be estimated to need (0: the default,
   /// default_max_memory_mb()).

@@ -5,6 +5,7 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <memory>
 #include <random>
 #include <string>
@@ -14,10 +15,21 @@
 #include "elastic/numerics/graph_laplacian.h"
 #include "elastic/numerics/multigrid.h"
 #include "elastic/sampling/boundary_sampler.h"
+#include "elastic/sampling/curvature_field.h"
 #include "elastic/sampling/region_texcoords.h"
 
 namespace elastic {
 namespace {
+
+/// Rounds of holding still the particles of failing faces in a Newton step (see newton_step).
+constexpr int kHoldRounds = 8;
+/// A Newton iteration whose largest move is above kContraction times the last one halves the
+/// step, down to kMinDamping (Sampler::damping).
+constexpr double kContraction = 0.9;
+constexpr double kMinDamping = 1.0 / 16.0;
+/// Newton iterations at kMinDamping without the largest move falling below kContraction times its
+/// best before the iteration stops as stalled.
+constexpr int kStallIterations = 30;
 
 /// Sine of the angle at corner c of a face (neighbours a before, b after), signed by the normal at
 /// c: positive when the corner turns counter-clockwise seen from the normal side, 1 for a right
@@ -36,7 +48,7 @@ void validate(const ParticleGrid& input, const AdaptiveSamplingOptions& options)
   const std::string& name = options.name;
   if (!(options.floor >= 0.0) || !(options.relaxation > 0.0 && options.relaxation <= 1.0) ||
       options.max_iterations < 0 || !(options.tolerance > 0.0) || !(options.jitter >= 0.0) ||
-      !(options.min_corner_sine < 1.0)) {
+      !(options.curvature_radius >= 0.0) || !(options.min_corner_sine < 1.0)) {
     throw InvalidInputError(name, "adaptive sampling options out of range");
   }
   const int np = input.num_particles();
@@ -61,10 +73,12 @@ class Sampler {
   void fix_weight_reference();
   /// Candidates of a Jacobi sweep of eq. 8 (all forces from the same state).
   void jacobi_candidates();
-  /// Candidates of a tangent Newton step scaled by `step` (see newton_step).
-  void newton_candidates(double step);
-  /// One tangent Newton step with backtracking; false when no step length keeps every face valid
-  /// (nothing moved then). `largest` receives the largest move.
+  /// Candidates of a tangent Newton step scaled by `step` (see newton_step); `solve` computes the
+  /// step, else the last one is scaled.
+  void newton_candidates(double step, bool solve);
+  /// One tangent Newton step with backtracking, taken particle by particle (guarded) when no step
+  /// length keeps every face valid; false when the step cannot be set up (an interior part not
+  /// tied to the boundary). `largest` receives the largest move.
   bool newton_step(double& largest);
   /// Sequential, guarded acceptance of the candidates; returns the largest accepted move.
   double accept_sequentially();
@@ -73,9 +87,13 @@ class Sampler {
 
   long rejected = 0;
   long cg_iterations = 0;
+  /// Scale of the Newton steps: halved when an iteration's largest move does not shrink (the
+  /// fixed point on the weights cycles, as in the nostrils of a scan).
+  double damping = 1.0;
 
  private:
-  void weight_at(const SurfacePoint& q, Eigen::Vector3d& n, double& w) const;
+  void weight_at(const Eigen::Vector3d& x, const SurfacePoint& q, Eigen::Vector3d& n,
+                 double& w) const;
   double weight(int p) const;
   double min_sine_around(int p) const;
   void project_interior();
@@ -94,6 +112,7 @@ class Sampler {
   std::vector<int> loop_index_;
   std::vector<double> s_;
   std::unique_ptr<BoundarySampler> sampler_;
+  std::unique_ptr<CurvatureField> field_;
   std::vector<Eigen::Vector3d> x_, normal_;
   std::vector<double> r_;
   std::vector<int> interior_;
@@ -168,7 +187,10 @@ Sampler::Sampler(ParticleGrid& grid, const Region& region, const SurfaceProjecto
   }
   normal_.resize(np_);
   r_.resize(np_);
-  tbb::parallel_for(0, np_, [&](int p) { weight_at(grid.source_points[p], normal_[p], r_[p]); });
+  field_ =
+      std::make_unique<CurvatureField>(region, options.curvature_radius * mean_spring_length());
+  tbb::parallel_for(0, np_,
+                    [&](int p) { weight_at(x_[p], grid.source_points[p], normal_[p], r_[p]); });
   new_x_.resize(np_);
   new_normal_.resize(np_);
   new_sp_.resize(np_);
@@ -180,11 +202,13 @@ Sampler::Sampler(ParticleGrid& grid, const Region& region, const SurfaceProjecto
   projected_.resize(interior_.size());
 }
 
-// Normal and curvature weight r = sqrt((k1^2 + k2^2) / 2) at a surface point.
-void Sampler::weight_at(const SurfacePoint& q, Eigen::Vector3d& n, double& w) const {
+// Normal and curvature measure r = sqrt((k1^2 + k2^2) / 2), averaged about x (curvature_field.h),
+// at a surface point q whose position is x.
+void Sampler::weight_at(const Eigen::Vector3d& x, const SurfacePoint& q, Eigen::Vector3d& n,
+                        double& w) const {
   const SurfaceCurvature c = surface_.curvature(q);
   n = c.normal;
-  w = std::sqrt(0.5 * (c.k1 * c.k1 + c.k2 * c.k2));
+  w = field_->radius() > 0.0 ? field_->at(x, q) : std::sqrt(0.5 * (c.k1 * c.k1 + c.k2 * c.k2));
 }
 
 // Weights (see the header): all 1 on a flat region, where eq. 8 degenerates to Laplacian
@@ -252,7 +276,7 @@ void Sampler::halfway(int p) {
 void Sampler::evaluate_candidate_weights() {
   tbb::parallel_for(0, np_, [&](int p) {
     if (moving_[p]) {
-      weight_at(new_sp_[p], new_normal_[p], new_r_[p]);
+      weight_at(new_x_[p], new_sp_[p], new_normal_[p], new_r_[p]);
     }
   });
 }
@@ -274,7 +298,7 @@ double Sampler::accept_sequentially() {
     for (int attempt = 0; attempt < 2 && !ok; ++attempt) {
       if (attempt == 1) {
         halfway(p);
-        weight_at(new_sp_[p], new_normal_[p], new_r_[p]);
+        weight_at(new_x_[p], new_sp_[p], new_normal_[p], new_r_[p]);
       }
       x_[p] = new_x_[p];
       sp[p] = new_sp_[p];
@@ -421,8 +445,8 @@ void Sampler::prepare_newton() {
 // equal and the surface is flat this is one exact solve of Laplacian smoothing's equilibrium, which
 // the Jacobi sweeps reach only after O(n) sweeps of one grid ring each; elsewhere it is repeated as
 // the weights follow the particles (a fixed-point iteration on w with a Newton step inside).
-void Sampler::newton_candidates(double step) {
-  if (step == 1.0) {
+void Sampler::newton_candidates(double step, bool solve) {
+  if (solve) {
     for (int p = 0; p < np_; ++p) {
       if (dim_[p] == 2) {
         const Eigen::Vector3d t1 = normal_[p].unitOrthogonal();
@@ -500,7 +524,11 @@ void Sampler::newton_candidates(double step) {
 // A Newton step moves every particle at once, coherently with its neighbours, so it is accepted
 // or refused as a whole: with all candidates in place, no corner of any face may turn the wrong
 // way or fall below min_corner_sine and below its previous value. The full step, then half and a
-// quarter of it, are tried.
+// quarter of it, are tried. When all three fail (a few particles in a crease of a scan would fold
+// a face), the full step is taken without the particles of the faces that would fail: they hold
+// still for this iteration and the test is repeated (holding a particle can spoil a face of a
+// neighbour that still moves). As a last resort every particle's move is guarded on its own, as
+// in a sweep. The next iteration tries a whole Newton step again.
 bool Sampler::newton_step(double& largest) {
   if (!newton_ready_) {
     try {
@@ -515,9 +543,10 @@ bool Sampler::newton_step(double& largest) {
   const std::vector<Eigen::Vector3d> old_x = x_, old_n = normal_;
   const std::vector<double> old_r = r_;
   const std::vector<SurfacePoint> old_sp = sp;
-  for (const double step : {1.0, 0.5, 0.25}) {
-    newton_candidates(step);
-    evaluate_candidate_weights();
+  std::vector<char> bad(np_, 0);
+  // Puts the moving candidates in place and marks the particles with a failing face; true when
+  // none fails (the candidates stay), else the state is restored.
+  const auto take = [&]() {
     for (int p = 0; p < np_; ++p) {
       if (moving_[p]) {
         x_[p] = new_x_[p];
@@ -526,7 +555,6 @@ bool Sampler::newton_step(double& largest) {
         r_[p] = new_r_[p];
       }
     }
-    std::vector<char> bad(np_, 0);
     tbb::parallel_for(0, np_, [&](int p) {
       const double after = min_sine_around(p);
       bad[p] = !(after > 0.0 && (after > options_.min_corner_sine || after >= before[p]));
@@ -535,9 +563,6 @@ bool Sampler::newton_step(double& largest) {
       largest = 0.0;
       for (int p = 0; p < np_; ++p) {
         largest = std::max(largest, (x_[p] - old_x[p]).norm());
-        if (moving_[p] && grid_.is_boundary[p]) {
-          s_[loop_index_[p]] = new_s_[p];
-        }
       }
       return true;
     }
@@ -545,8 +570,35 @@ bool Sampler::newton_step(double& largest) {
     normal_ = old_n;
     r_ = old_r;
     sp = old_sp;
+    return false;
+  };
+  for (const double fraction : {1.0, 0.5, 0.25}) {
+    const double step = fraction * damping;
+    newton_candidates(step, fraction == 1.0);
+    evaluate_candidate_weights();
+    if (take()) {
+      return true;
+    }
   }
-  return false;
+  newton_candidates(damping, false);
+  evaluate_candidate_weights();
+  for (int round = 0; round < kHoldRounds; ++round) {
+    for (int p = 0; p < np_; ++p) {
+      if (bad[p]) {
+        for (int k = vertex_faces_.start[p]; k < vertex_faces_.start[p + 1]; ++k) {
+          const int f = vertex_faces_.items[k];
+          for (int c = faces_.start[f]; c < faces_.start[f + 1]; ++c) {
+            moving_[faces_.items[c]] = 0;
+          }
+        }
+      }
+    }
+    if (take()) {
+      return true;
+    }
+  }
+  largest = accept_sequentially();
+  return true;
 }
 
 // Write back: positions, boundary parameters, UVs, springs.
@@ -587,18 +639,25 @@ AdaptiveSamplingResult adaptive_sampling(const ParticleGrid& input, const Region
   sampler.fix_weight_reference();
 
   bool newton = options.method == SamplingMethod::Newton;
+  double best_move = std::numeric_limits<double>::infinity();
+  int best_at = 0;
   for (int it = 0; it < options.max_iterations; ++it) {
     double largest = 0.0;
     if (newton && sampler.newton_step(largest)) {
       ++result.newton_steps;
     } else {
-      // A refused Newton step (a face would fold) hands over to the guarded sweeps for good.
+      // No Newton step can be set up (an interior part not tied to the boundary): the guarded
+      // sweeps take over for good.
       newton = false;
       sampler.jacobi_candidates();
       largest = sampler.accept_sequentially();
     }
     result.iterations = it + 1;
+    const double previous = result.max_move;
     result.max_move = largest / sampler.mean_spring_length();
+    if (newton && it > 0 && result.max_move > kContraction * previous) {
+      sampler.damping = std::max(0.5 * sampler.damping, kMinDamping);
+    }
     result.converged = result.max_move < options.tolerance;
     if (!report_progress(options.progress, Progress{.stage = "adaptive sampling",
                                                     .iteration = it + 1,
@@ -609,6 +668,16 @@ AdaptiveSamplingResult adaptive_sampling(const ParticleGrid& input, const Region
       break;
     }
     if (result.converged) {
+      break;
+    }
+    // At the smallest step the largest move has not fallen below kContraction times its best for
+    // kStallIterations: the cycle does not contract any further (a crease of a scan), more
+    // iterations only cost.
+    if (result.max_move < kContraction * best_move) {
+      best_move = result.max_move;
+      best_at = it;
+    } else if (newton && sampler.damping == kMinDamping && it - best_at >= kStallIterations) {
+      result.stalled = true;
       break;
     }
   }

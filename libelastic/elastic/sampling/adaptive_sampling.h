@@ -4,7 +4,8 @@
 /// grid's connectivity unchanged, towards where the surface bends.
 ///
 /// Each interior particle i is pulled towards its grid neighbours j (the edges of the grid) with
-/// weights built on the paper's curvature measure r = sqrt((k1^2 + k2^2) / 2) (§4.3):
+/// weights built on the paper's curvature measure r = sqrt((k1^2 + k2^2) / 2) (§4.3), averaged over
+/// about one grid spacing (`curvature_radius`, curvature_field.h):
 ///
 ///     w_j = min(r(x_j), max_weight * rbar0) + floor * rbar0
 ///
@@ -32,7 +33,8 @@
 /// in index order, so the result does not depend on the number of threads.
 ///
 /// Iterations stop when the largest move is below `tolerance` times the mean spring length, after
-/// `max_iterations`, or when the progress callback asks to stop. Springs' rest values are rebuilt
+/// `max_iterations`, when the Newton steps stall (below), or when the progress callback asks to
+/// stop. Springs' rest values are rebuilt
 /// on the final positions (ParticleGrid::build_springs). Source UVs (when present) are
 /// re-interpolated from the region's vertex texture coordinates at each particle's new surface
 /// point.
@@ -44,8 +46,11 @@
 /// preconditioned conjugate gradients (numerics/conjugate_gradient.h; preconditioner: a multigrid
 /// V-cycle of the scalar weighted Laplacian, numerics/multigrid.h), puts the particles back on the
 /// surface (the magnet), and is accepted as a whole when no face corner turns or thins as above
-/// (else half, then a quarter of it; if all three fail the iteration falls back to the guarded
-/// Jacobi sweeps for good). The weights are then re-evaluated, so the iteration is a fixed point on
+/// (else half, then a quarter of it; if all three fail, the full step is taken with the particles
+/// of the failing faces held still for that iteration, and as a last resort with each particle's
+/// move guarded as in a sweep). An iteration whose largest move does not shrink by 10% halves the
+/// following steps (down to 1/16): on a scan the fixed point can cycle between two states. The
+/// weights are then re-evaluated, so the iteration is a fixed point on
 /// w with a Newton step inside (it contracted by about 3x per step on spot.obj); its fixed point is
 /// eq. 8's. Newton steps hold the boundary particles at their equal-arc-length layout
 /// (`move_boundary` applies to the sweeps): with sliding boundary unknowns the step follows the
@@ -79,6 +84,12 @@ struct AdaptiveSamplingOptions {
   /// Curvature weights above max_weight times that mean are clamped to it (0: no clamp). Bounds the
   /// density contrast near sharp features, where r is huge and would drain everything else.
   double max_weight = 0.0;
+  /// Width s of the kernel over which the curvature measure r is averaged (that of a Gaussian of
+  /// standard deviation s; it reaches 3 s), in mean grid spacings of the layout
+  /// (curvature_field.h); 0 is the paper's pointwise r. Particles
+  /// cannot follow curvature that changes within a spacing: on a scan the pointwise r is noise at
+  /// that scale and the iteration does not settle. Must be >= 0.
+  double curvature_radius = 1.0;
   /// Fraction of the Jacobi displacement applied per sweep, in (0, 1] (Newton steps are taken in
   /// full, then halved when a face would fold).
   double relaxation = 0.8;
@@ -108,11 +119,14 @@ struct AdaptiveSamplingOptions {
 struct AdaptiveSamplingResult {
   ParticleGrid grid;       ///< the sampled grid (same connectivity as the input, springs rebuilt)
   int iterations = 0;      ///< iterations done (Newton steps + Jacobi sweeps)
-  int newton_steps = 0;    ///< iterations that were accepted Newton steps
+  int newton_steps = 0;    ///< iterations that were Newton steps (whole, held or guarded)
   long cg_iterations = 0;  ///< conjugate-gradient iterations of all Newton steps
   double max_move = 0.0;   ///< largest move of the last iteration / mean spring length
   bool converged = false;  ///< max_move fell below the tolerance
   bool cancelled = false;  ///< the progress callback asked to stop
+  /// Stopped before max_iterations without converging: the Newton steps, at their smallest
+  /// damping, did not shrink the largest move by 10% for 30 iterations.
+  bool stalled = false;
   long rejected_moves =
       0;  ///< moves rejected (not merely halved) to keep faces valid, all iterations
   double mean_curvature_weight = 0.0;  ///< mean r over the particles at the end

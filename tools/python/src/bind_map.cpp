@@ -40,6 +40,7 @@ struct MapKeywords {
   double jitter = 0.0;
   unsigned long seed = 0;
   long max_iterations = 0;
+  double curvature_radius = AdaptiveSamplingOptions{}.curvature_radius;
 };
 
 // The MapOptions of `elastic map` for the same flags (tools/elastic/map_job.cpp).
@@ -65,11 +66,16 @@ MapOptions map_options(const MapKeywords& k) {
   if (k.seed != 0 && k.jitter == 0.0) {
     throw py::value_error("seed: chooses the random start of jitter, which is 0: give jitter");
   }
+  if (!(k.curvature_radius >= 0.0 && k.curvature_radius <= 100.0)) {
+    throw py::value_error("curvature_radius: expected grid spacings in [0, 100], got " +
+                          std::to_string(k.curvature_radius));
+  }
   MapOptions options;
   options.sampling.layout.particles = k.particles;
   options.sampling.layout.name = "source_region";
   options.sampling.sampling.seed = k.seed;
   options.sampling.sampling.jitter = k.jitter;
+  options.sampling.sampling.curvature_radius = k.curvature_radius;
   options.rest_scale = parse_rest_scale(k.rest_scale, "rest_scale");
   options.relaxation.solver = k.solver == "explicit" ? SolverKind::Faithful : SolverKind::Fast;
   options.relaxation.energy = parse_energy_kind(k.energy, "energy");
@@ -361,11 +367,11 @@ void bind_map(py::module_& m) {
          const std::string& boundary, const std::string& boundary_offset,
          const std::string& preconditioner, const py::object& angular_stiffness, int subdivide,
          int threads, double jitter, unsigned long seed, long max_iterations,
-         const py::object& progress) {
-        const MapKeywords k{particles,     solver,          energy,         rest_scale,
-                            boundary,      boundary_offset, preconditioner, angular_stiffness,
-                            subdivide,     threads,         jitter,         seed,
-                            max_iterations};
+         double curvature_radius, const py::object& progress) {
+        const MapKeywords k{particles,      solver,          energy,         rest_scale,
+                            boundary,       boundary_offset, preconditioner, angular_stiffness,
+                            subdivide,      threads,         jitter,         seed,
+                            max_iterations, curvature_radius};
         return run_map(source_region, target_region, k, progress);
       },
       py::arg("source_region"), py::arg("target_region"), py::kw_only(),
@@ -374,6 +380,7 @@ void bind_map(py::module_& m) {
       py::arg("boundary_offset") = "auto", py::arg("preconditioner") = "multigrid",
       py::arg("angular_stiffness") = py::none(), py::arg("subdivide") = 0, py::arg("threads") = 0,
       py::arg("jitter") = 0.0, py::arg("seed") = 0, py::arg("max_iterations") = 0,
+      py::arg("curvature_radius") = AdaptiveSamplingOptions{}.curvature_radius,
       py::arg("progress") = py::none(),
       "Maps source_region onto target_region (each a Region of its Surface) with the particle "
       "system: the keywords are the flags of `elastic map` (docs/cli.md) with underscores. "
