@@ -22,6 +22,9 @@ using FaceIndex = Mesh::Face_index;
 /// How far (in barycentric terms) a path's end point is moved into its triangle for CGAL
 /// (Impl::cgal_bary).
 constexpr double kInside = 1e-9;
+/// Crossings closer than this times the end's triangle perimeter to a path end are dropped (the
+/// moved end's own edge, see path()).
+constexpr double kDropNearEnd = 1e-6;
 using HalfedgeIndex = Mesh::Halfedge_index;
 
 /// A point of the path as weights on at most three mesh vertices (an edge point has two, a
@@ -85,7 +88,7 @@ struct ExactGeodesics::Impl {
     }
   }
 
-  ShortestPath::Barycentric_coordinates cgal_bary(const MeshLocation& p) const {
+  ShortestPath::Barycentric_coordinates cgal_bary(const MeshLocation& p, double inside) const {
     // CGAL's coordinate k weighs source(next^k(halfedge(f))) (its triangle_from_halfedge), a
     // cycle that need not start at our corner 0.
     //
@@ -108,8 +111,8 @@ struct ExactGeodesics::Impl {
       }
       h = mesh.next(h);
     }
-    const double n = 1.0 - 3.0 * kInside;
-    return {n * b[0] + kInside, n * b[1] + kInside, n * b[2] + kInside};
+    const double n = 1.0 - 3.0 * inside;
+    return {n * b[0] + inside, n * b[1] + inside, n * b[2] + inside};
   }
 
   Weights weights_of(const MeshLocation& p) const {
@@ -185,7 +188,7 @@ std::vector<PathNode> ExactGeodesics::path(const MeshLocation& from, const MeshL
   const auto face = [&](const MeshLocation& p) {
     return FaceIndex(static_cast<Mesh::size_type>(m.face_of[static_cast<size_t>(p.triangle)]));
   };
-  smsp.add_source_point(face(to), m.cgal_bary(to));
+  smsp.add_source_point(face(to), m.cgal_bary(to, kInside));
   smsp.build_sequence_tree();
 
   // The sequence runs from the query point (`from`) to the source (`to`); the end points are
@@ -223,11 +226,33 @@ std::vector<PathNode> ExactGeodesics::path(const MeshLocation& from, const MeshL
   };
   Visitor visitor{m.mesh, m.vertices, seq};
   const auto result =
-      smsp.shortest_path_sequence_to_source_points(face(from), m.cgal_bary(from), visitor);
+      smsp.shortest_path_sequence_to_source_points(face(from), m.cgal_bary(from, kInside), visitor);
   if (!(result.first >= 0.0)) {
     throw NumericalError(m.name, "no path between two curve points (is the surface in pieces?)");
   }
   seq.push_back(m.weights_of(to));
+  // An end moved kInside for CGAL makes the path cross the end's own edge (or pass its vertex)
+  // within about kInside of it: such crossings are dropped, the ends are taken as given.
+  const auto where = [&](const Weights& p) {
+    Eigen::Vector3d s = Eigen::Vector3d::Zero();
+    for (const auto& [v, w] : p.w) s += w * m.x[static_cast<size_t>(v)];
+    return s;
+  };
+  const auto size_of = [&](const MeshLocation& p) {
+    const Eigen::Vector3i& c = m.tri[static_cast<size_t>(p.triangle)];
+    return (m.x[static_cast<size_t>(c[1])] - m.x[static_cast<size_t>(c[0])]).norm() +
+           (m.x[static_cast<size_t>(c[2])] - m.x[static_cast<size_t>(c[1])]).norm() +
+           (m.x[static_cast<size_t>(c[0])] - m.x[static_cast<size_t>(c[2])]).norm();
+  };
+  const Eigen::Vector3d start = where(seq.front()), end = where(seq.back());
+  const double near_start = kDropNearEnd * size_of(from), near_end = kDropNearEnd * size_of(to);
+  std::vector<Weights> kept{seq.front()};
+  for (size_t i = 1; i + 1 < seq.size(); ++i) {
+    const Eigen::Vector3d p = where(seq[i]);
+    if ((p - start).norm() > near_start && (p - end).norm() > near_end) kept.push_back(seq[i]);
+  }
+  kept.push_back(seq.back());
+  seq = std::move(kept);
 
   std::vector<PathNode> out;
   for (size_t i = 0; i + 1 < seq.size(); ++i) {
