@@ -235,7 +235,9 @@ std::vector<PathNode> ExactGeodesics::path(const MeshLocation& from, const MeshL
   // within about kInside of it: such crossings are dropped, the ends are taken as given.
   const auto where = [&](const Weights& p) {
     Eigen::Vector3d s = Eigen::Vector3d::Zero();
-    for (const auto& [v, w] : p.w) s += w * m.x[static_cast<size_t>(v)];
+    for (const auto& [v, w] : p.w) {
+      s += w * m.x[static_cast<size_t>(v)];
+    }
     return s;
   };
   const auto size_of = [&](const MeshLocation& p) {
@@ -249,7 +251,9 @@ std::vector<PathNode> ExactGeodesics::path(const MeshLocation& from, const MeshL
   std::vector<Weights> kept{seq.front()};
   for (size_t i = 1; i + 1 < seq.size(); ++i) {
     const Eigen::Vector3d p = where(seq[i]);
-    if ((p - start).norm() > near_start && (p - end).norm() > near_end) kept.push_back(seq[i]);
+    if ((p - start).norm() > near_start && (p - end).norm() > near_end) {
+      kept.push_back(seq[i]);
+    }
   }
   kept.push_back(seq.back());
   seq = std::move(kept);
