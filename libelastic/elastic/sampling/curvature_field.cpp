@@ -12,6 +12,7 @@ namespace {
 
 constexpr long kAxisCells = 1L << 20;  // cells per axis the 64-bit key can hold
 constexpr double kSupport = 3.0;       // the kernel reaches kSupport * s
+constexpr double kConstant = 1e-9;     // relative spread of r below which the field is constant
 
 }  // namespace
 
@@ -51,6 +52,13 @@ CurvatureField::CurvatureField(const Region& region, double radius) : surface_(*
 
   std::vector<double> r(nv);
   tbb::parallel_for(0, nv, [&](int v) { r[v] = pointwise(surface_, region.points[v]); });
+  // A region of constant r (a plane: r = 0 to round-off) averages to that constant everywhere:
+  // no index is needed and no query is made.
+  const auto [r_min, r_max] = std::minmax_element(r.begin(), r.end());
+  if (*r_max - *r_min <= kConstant * std::max(*r_max, 1.0 / (hi - lo).norm())) {
+    constant_ = 0.5 * (*r_min + *r_max);
+    return;
+  }
   std::vector<std::uint64_t> key(nv);
   for (int v = 0; v < nv; ++v) {
     const Eigen::Vector3d c = (region.positions[v] - origin_) / cell_;
@@ -82,6 +90,9 @@ std::uint64_t CurvatureField::cell_key(long ix, long iy, long iz) const {
 }
 
 double CurvatureField::at(const Eigen::Vector3d& x, const SurfacePoint& q) const {
+  if (constant_) {
+    return *constant_;
+  }
   if (key_.empty()) {
     return pointwise(surface_, q);
   }

@@ -26,10 +26,12 @@
 /// Distances are straight-line, in space: on a region whose two sheets come within 3 s of each
 /// other (a fold thinner than the particle spacing) the sheets share their curvature, which the
 /// particles could not tell apart either. s is never below the tessellation's mean edge length,
-/// so at least a ring of vertices falls inside the kernel.
+/// so at least a ring of vertices falls inside the kernel. Where r is the same at every vertex (to
+/// 1e-9 relative; a plane) the field is that constant and no query searches.
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include "elastic/regions/region.h"
@@ -63,6 +65,7 @@ class CurvatureField {
   std::vector<Eigen::Vector3d> position_;
   std::vector<double> weighted_r_, area_;  // A_v r_v and A_v, sorted by cell
   std::vector<std::uint64_t> key_;         // cell of each vertex, sorted
+  std::optional<double> constant_;         // r where it is the same at every vertex
 };
 
 }  // namespace elastic
