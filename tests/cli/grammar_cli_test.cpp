@@ -246,6 +246,14 @@ TEST(Grammar, ReportKeysAreNamedOneWayAndDocumented) {
     EXPECT_EQ(sample["sampling"][key], map["sampling"][key]);
     EXPECT_NE(formats.find(std::string("`") + key + "`"), std::string::npos);
   }
+  // The adaptive sampling's own verdict: under "adaptive" in sample, in "sampling" in map.
+  for (const char* key : {"iterations", "converged", "stalled"}) {
+    SCOPED_TRACE(key);
+    ASSERT_TRUE(sample["adaptive"].contains(key)) << sample.dump();
+    EXPECT_EQ(sample["adaptive"][key], map["sampling"][key]);
+    EXPECT_NE(formats.find(std::string("`") + key + "`"), std::string::npos);
+  }
+  EXPECT_EQ(sample["adaptive"]["last_max_move"], map["sampling"]["last_move"]);
   EXPECT_FALSE(sample.contains("normal_springs"));
   EXPECT_FALSE(sample.contains("angular_springs"));
 }

@@ -342,7 +342,13 @@ nlohmann::json map_report(const MapJob& job, const MapSession& session,
        {{"spacing_min", s.spacing_min},
         {"spacing_median", s.spacing_median},
         {"spacing_max", s.spacing_max},
-        {"density_ratio", s.density_ratio}}}};
+        {"density_ratio", s.density_ratio},
+        // The adaptive sampling's own iteration (§4.3): a scan's creases can keep it from
+        // settling (docs/sampling.md); the map is judged on its own all the same.
+        {"iterations", r.sampling.sampling.iterations},
+        {"converged", r.sampling.sampling.converged},
+        {"stalled", r.sampling.sampling.stalled},
+        {"last_move", r.sampling.sampling.max_move}}}};
 }
 
 MapMetrics measure_placement(const MapSession& session, const Eigen::Matrix3Xd& positions,
