@@ -140,6 +140,38 @@ struct ExactGeodesics::Impl {
     return -1;
   }
 
+  /// The path's points without the crossings within kDropNearEnd of an end (see path()).
+  std::vector<Weights> drop_crossings_near_ends(const std::vector<Weights>& seq,
+                                                const MeshLocation& from,
+                                                const MeshLocation& to) const {
+    // An end moved kInside for CGAL makes the path cross the end's own edge (or pass its vertex)
+    // within about kInside of it: such crossings are dropped, the ends are taken as given.
+    const auto where = [&](const Weights& p) {
+      Eigen::Vector3d s = Eigen::Vector3d::Zero();
+      for (const auto& [v, w] : p.w) {
+        s += w * x[static_cast<size_t>(v)];
+      }
+      return s;
+    };
+    const auto size_of = [&](const MeshLocation& p) {
+      const Eigen::Vector3i& c = tri[static_cast<size_t>(p.triangle)];
+      return (x[static_cast<size_t>(c[1])] - x[static_cast<size_t>(c[0])]).norm() +
+             (x[static_cast<size_t>(c[2])] - x[static_cast<size_t>(c[1])]).norm() +
+             (x[static_cast<size_t>(c[0])] - x[static_cast<size_t>(c[2])]).norm();
+    };
+    const Eigen::Vector3d start = where(seq.front()), end = where(seq.back());
+    const double near_start = kDropNearEnd * size_of(from), near_end = kDropNearEnd * size_of(to);
+    std::vector<Weights> kept{seq.front()};
+    for (size_t i = 1; i + 1 < seq.size(); ++i) {
+      const Eigen::Vector3d p = where(seq[i]);
+      if ((p - start).norm() > near_start && (p - end).norm() > near_end) {
+        kept.push_back(seq[i]);
+      }
+    }
+    kept.push_back(seq.back());
+    return kept;
+  }
+
   MeshLocation location_in(const Weights& p, int t) const {
     MeshLocation m{t, Eigen::Vector3d::Zero()};
     for (const auto& [v, w] : p.w) {
@@ -231,32 +263,7 @@ std::vector<PathNode> ExactGeodesics::path(const MeshLocation& from, const MeshL
     throw NumericalError(m.name, "no path between two curve points (is the surface in pieces?)");
   }
   seq.push_back(m.weights_of(to));
-  // An end moved kInside for CGAL makes the path cross the end's own edge (or pass its vertex)
-  // within about kInside of it: such crossings are dropped, the ends are taken as given.
-  const auto where = [&](const Weights& p) {
-    Eigen::Vector3d s = Eigen::Vector3d::Zero();
-    for (const auto& [v, w] : p.w) {
-      s += w * m.x[static_cast<size_t>(v)];
-    }
-    return s;
-  };
-  const auto size_of = [&](const MeshLocation& p) {
-    const Eigen::Vector3i& c = m.tri[static_cast<size_t>(p.triangle)];
-    return (m.x[static_cast<size_t>(c[1])] - m.x[static_cast<size_t>(c[0])]).norm() +
-           (m.x[static_cast<size_t>(c[2])] - m.x[static_cast<size_t>(c[1])]).norm() +
-           (m.x[static_cast<size_t>(c[0])] - m.x[static_cast<size_t>(c[2])]).norm();
-  };
-  const Eigen::Vector3d start = where(seq.front()), end = where(seq.back());
-  const double near_start = kDropNearEnd * size_of(from), near_end = kDropNearEnd * size_of(to);
-  std::vector<Weights> kept{seq.front()};
-  for (size_t i = 1; i + 1 < seq.size(); ++i) {
-    const Eigen::Vector3d p = where(seq[i]);
-    if ((p - start).norm() > near_start && (p - end).norm() > near_end) {
-      kept.push_back(seq[i]);
-    }
-  }
-  kept.push_back(seq.back());
-  seq = std::move(kept);
+  seq = m.drop_crossings_near_ends(seq, from, to);
 
   std::vector<PathNode> out;
   for (size_t i = 0; i + 1 < seq.size(); ++i) {
