@@ -73,7 +73,15 @@ std::string_view to_string(StopReason reason) {
 }
 
 std::string_view to_string(BoundaryMode mode) {
-  return mode == BoundaryMode::Fixed ? "fixed" : "slide";
+  switch (mode) {
+    case BoundaryMode::Fixed:
+      return "fixed";
+    case BoundaryMode::Slide:
+      return "slide";
+    case BoundaryMode::Free:
+      return "free";
+  }
+  return "fixed";
 }
 
 BoundaryMode parse_boundary_mode(std::string_view text, std::string_view input) {
@@ -83,8 +91,11 @@ BoundaryMode parse_boundary_mode(std::string_view text, std::string_view input) 
   if (text == "slide") {
     return BoundaryMode::Slide;
   }
+  if (text == "free") {
+    return BoundaryMode::Free;
+  }
   throw InvalidInputError(std::string(input), "unknown boundary mode '" + std::string(text) +
-                                                  "' (expected fixed or slide)");
+                                                  "' (expected fixed, slide or free)");
 }
 
 std::string_view to_string(EnergyKind kind) {

@@ -124,11 +124,17 @@ enum class BoundaryMode {
   /// They stay on the target curve, in order, and slide along it to lower the energy (fast solver;
   /// needs RelaxationProblem::boundary_curve), then are held there while the interior settles
   /// (RelaxationResult::slide_iterations). The faithful solver keeps them fixed.
-  Slide
+  Slide,
+  /// Nothing holds them to a curve: every particle moves on the target surface, except the ones
+  /// in RelaxationProblem::pinned (at least one, which removes the translations). A decal's free
+  /// boundary (mapping/map_decal.h): the angular springs keep the boundary's corners, the length
+  /// springs its edges. Rotation about the pinned particle stays free; the energy chooses it (on
+  /// a plane it is a null direction and the start's is kept).
+  Free
 };
-/// "fixed", "slide".
+/// "fixed", "slide", "free".
 std::string_view to_string(BoundaryMode mode);
-/// Parses "fixed" or "slide". \throws InvalidInputError naming `input` otherwise.
+/// Parses "fixed", "slide" or "free". \throws InvalidInputError naming `input` otherwise.
 BoundaryMode parse_boundary_mode(std::string_view text, std::string_view input = "boundary");
 
 /// Which energy the relaxation minimises.
@@ -223,6 +229,8 @@ struct RelaxationProblem {
   /// Start parameters s_k of the boundary particles (one per grid.boundary_loop entry) for
   /// BoundaryMode::Slide; empty: the grid's boundary_parameter.
   std::vector<double> boundary_parameters;
+  /// BoundaryMode::Free: particles held where they start (at least one); ignored otherwise.
+  std::vector<int> pinned;
   /// The |P g| that the relative tolerances (relative_gradient_tolerance,
   /// round_off_gradient_tolerance) refer to; 0: this start's own. A later phase of one relaxation
   /// (the held phase after a slide, the barrier run after an untangling) passes the first phase's,
@@ -269,7 +277,7 @@ struct RelaxationResult {
   long untangle_steps = 0;
   bool untangled = false;
   /// Max distance of a boundary particle from its target position (Fixed) or from the curve point
-  /// at its parameter (Slide).
+  /// at its parameter (Slide); of a pinned particle from its start (Free).
   double boundary_residual = 0.0;
   BoundaryMode boundary = BoundaryMode::Fixed;  ///< the boundary mode used
   /// Final correspondence parameter of each boundary particle (grid.boundary_loop order); with a

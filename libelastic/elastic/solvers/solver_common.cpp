@@ -89,6 +89,26 @@ void choose_free_particles(const RelaxationProblem& problem, const RelaxationOpt
     setup.is_free[p] = 1;
     setup.interior.push_back(static_cast<int>(p));
   };
+  if (options.boundary == BoundaryMode::Free) {
+    // Every particle but the pinned ones (which remove the translations, and with them the spring
+    // Laplacian's null space).
+    std::vector<char> pinned(P, 0);
+    for (const int p : problem.pinned) {
+      if (p < 0 || static_cast<std::size_t>(p) >= P) {
+        throw InvalidInputError(kName, "pinned particle " + std::to_string(p) + " out of range");
+      }
+      pinned[static_cast<std::size_t>(p)] = 1;
+    }
+    if (problem.pinned.empty()) {
+      throw InvalidInputError(kName, "a free boundary needs at least one pinned particle");
+    }
+    for (std::size_t p = 0; p < P; ++p) {
+      if (pinned[p] == 0) make_free(p);
+    }
+    setup.sliding.assign(setup.interior.size(), -1);
+    setup.free_boundary = true;
+    return;
+  }
   for (std::size_t p = 0; p < P; ++p) {
     if (!grid.is_boundary[p]) {
       make_free(p);
@@ -268,7 +288,16 @@ void finish_result(const RelaxationSetup& setup, const RelaxationProblem& proble
       initial_gradient_norm > 0.0 ? result.gradient_norm / initial_gradient_norm : 0.0;
   result.folded_faces = setup.springs.folded_faces(setup.positions, setup.normals);
   result.boundary = setup.slide ? BoundaryMode::Slide : BoundaryMode::Fixed;
-  if (setup.slide) {
+  if (setup.free_boundary) {
+    result.boundary = BoundaryMode::Free;
+    result.boundary_parameters = setup.grid.boundary_parameter;
+    result.boundary_residual = 0.0;
+    for (const int p : problem.pinned) {
+      result.boundary_residual =
+          std::max(result.boundary_residual,
+                   (setup.positions.col(p) - problem.initial_positions.col(p)).norm());
+    }
+  } else if (setup.slide) {
     // On the curve by construction: measured against the curve point at each final parameter.
     result.boundary_parameters = setup.curve_s;
     result.boundary_residual = 0.0;

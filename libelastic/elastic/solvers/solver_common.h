@@ -39,6 +39,8 @@ struct RelaxationSetup {
   // Sliding boundary (BoundaryMode::Slide, fast solver): the boundary particles are free entries
   // too (at the end of `interior`), each moving along the curve only.
   bool slide = false;
+  /// BoundaryMode::Free: every particle is free except RelaxationProblem::pinned.
+  bool free_boundary = false;
   /// Per entry of `interior`: its index in grid.boundary_loop when it is a sliding boundary
   /// particle, -1 for an interior particle.
   std::vector<int> sliding;
