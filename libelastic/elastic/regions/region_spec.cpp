@@ -416,6 +416,58 @@ void embed_curve(CutMesh& cut, const std::vector<MeshLocation>& nodes, Chart cha
   }
 }
 
+/// The bands the sides of a `points:` polygon are searched in (RegionOptions::euclidean_bands):
+/// from heat distances (computed the first time a side needs them) or from 3D distances.
+class SideBands {
+ public:
+  SideBands(const Context& ctx, const std::vector<MeshLocation>& locs,
+            const std::vector<Eigen::Vector3d>& where)
+      : ctx_(ctx), locs_(locs), where_(where) {
+    double sum = 0.0;
+    for (const Eigen::Vector3i& t : ctx.tess.triangles) {
+      for (int k = 0; k < 3; ++k) {
+        sum += (ctx.tess.positions[static_cast<size_t>(t[k])] -
+                ctx.tess.positions[static_cast<size_t>(t[(k + 1) % 3])])
+                   .norm();
+      }
+    }
+    mean_edge_ = ctx.tess.triangles.empty()
+                     ? 0.0
+                     : sum / (3.0 * static_cast<double>(ctx.tess.triangles.size()));
+  }
+
+  std::vector<char> heat(size_t i, size_t j) {
+    if (!heat_) {
+      heat_ = std::make_unique<regions_detail::HeatGeodesics>(
+          ctx_.tess.positions, ctx_.tess.triangles, ctx_.options.name);
+      dist_.resize(locs_.size());
+    }
+    for (const size_t k : {i, j}) {
+      if (dist_[k].size() == 0) dist_[k] = heat_->distance(locs_[k]);
+    }
+    return regions_detail::geodesic_band(ctx_.tess.triangles, dist_[i], dist_[j], 0.5,
+                                         4.0 * heat_->mean_edge_length());
+  }
+
+  std::vector<char> euclidean(size_t i, size_t j) const {
+    const std::vector<Eigen::Vector3d>& x = ctx_.tess.positions;
+    Eigen::VectorXd from(static_cast<Eigen::Index>(x.size())), to(from.size());
+    for (size_t v = 0; v < x.size(); ++v) {
+      from[static_cast<Eigen::Index>(v)] = (x[v] - where_[i]).norm();
+      to[static_cast<Eigen::Index>(v)] = (x[v] - where_[j]).norm();
+    }
+    return regions_detail::geodesic_band(ctx_.tess.triangles, from, to, 0.5, 4.0 * mean_edge_);
+  }
+
+ private:
+  const Context& ctx_;
+  const std::vector<MeshLocation>& locs_;
+  const std::vector<Eigen::Vector3d>& where_;
+  double mean_edge_ = 0.0;
+  std::unique_ptr<regions_detail::HeatGeodesics> heat_;
+  std::vector<Eigen::VectorXd> dist_;
+};
+
 Region points_region(const Context& ctx, const RegionSpec& spec) {
   const std::string& name = ctx.options.name;
   std::vector<MeshLocation> locs;
@@ -447,18 +499,22 @@ Region points_region(const Context& ctx, const RegionSpec& spec) {
   // why not the heat method's traced paths).
   // The search for each side is confined to the band of paths at most 50% longer than the
   // shortest (plus four edges for the heat distance's error) around it.
-  const regions_detail::HeatGeodesics heat(ctx.tess.positions, ctx.tess.triangles, name);
   regions_detail::ExactGeodesics geodesics(ctx.tess.positions, ctx.tess.triangles, name);
-  std::vector<Eigen::VectorXd> dist(locs.size());
-  for (size_t i = 0; i < locs.size(); ++i) {
-    dist[i] = heat.distance(locs[i]);
-  }
+  SideBands bands(ctx, locs, where);
   std::vector<MeshLocation> nodes;
   for (size_t i = 0; i < locs.size(); ++i) {
     const size_t j = (i + 1) % locs.size();
-    const std::vector<char> band = regions_detail::geodesic_band(
-        ctx.tess.triangles, dist[i], dist[j], 0.5, 4.0 * heat.mean_edge_length());
-    const auto path = geodesics.path(locs[i], locs[j], band);
+    std::vector<regions_detail::PathNode> path;
+    if (ctx.options.euclidean_bands) {
+      try {
+        path = geodesics.path(locs[i], locs[j], bands.euclidean(i, j));
+      } catch (const Error&) {
+        // The chord's band does not hold the path (or is not a manifold where it pinches
+        // between two sheets): the heat band below.
+        path.clear();
+      }
+    }
+    if (path.empty()) path = geodesics.path(locs[i], locs[j], bands.heat(i, j));
     for (const auto& node : path) {
       // Express the node in the triangle that holds the segment leaving it.
       MeshLocation m{node.segment_triangle, Eigen::Vector3d::Zero()};

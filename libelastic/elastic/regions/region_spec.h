@@ -56,6 +56,15 @@ struct RegionOptions {
   double max_point_distance = 0.05;
   /// Name used in error messages, e.g. "--target-region".
   std::string name = "region";
+  /// `points:` only. Each side's exact shortest path is searched in a band of the tessellation
+  /// around it: by default the band of the heat method's distances from both ends (one heat solve
+  /// per point: right for any polygon a user draws). When set, the band of the 3D distances from
+  /// both ends instead (triangles whose corners' distances to the two ends add up to at most 1.5
+  /// times the ends' distance plus four tessellation edges), which needs no solve: for many
+  /// closely spaced points along a smooth curve, whose sides are nearly straight chords (a placed
+  /// decal's relaxed boundary, mapping/map_decal.h). A side whose path the band does not hold
+  /// falls back to the heat band.
+  bool euclidean_bands = false;
 };
 
 /// Builds the region of `spec` on the projector's surface, boundary counter-clockwise seen from the
