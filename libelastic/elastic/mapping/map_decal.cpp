@@ -1,0 +1,422 @@
+#include "elastic/mapping/map_decal.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <numbers>
+#include <sstream>
+#include <unordered_map>
+
+#include "elastic/core/error.h"
+#include "elastic/regions/region_spec.h"
+
+namespace elastic {
+
+namespace {
+
+double seconds_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+std::string number(double value) {
+  std::ostringstream out;
+  out.precision(3);
+  out << value;
+  return out.str();
+}
+
+// Unit normal du x dv at a surface point (nudged off a singular parameterisation by the
+// projector's answer at the point itself).
+Eigen::Vector3d unit_normal(const SurfaceProjector& projector, const SurfacePoint& p,
+                            const Eigen::Vector3d& position) {
+  const SurfaceDerivatives d = projector.surface().derivatives(p);
+  const Eigen::Vector3d n = d.du.cross(d.dv);
+  if (n.norm() > 1e-300) return n.normalized();
+  return projector.closest(position, p).normal;
+}
+
+Eigen::Matrix3Xd unit_normals(const SurfaceProjector& projector, const InitialMap& placement) {
+  Eigen::Matrix3Xd normals(3, placement.positions.cols());
+  tbb::parallel_for(tbb::blocked_range<Eigen::Index>(0, placement.positions.cols(), 256),
+                    [&](const tbb::blocked_range<Eigen::Index>& range) {
+                      for (Eigen::Index p = range.begin(); p != range.end(); ++p) {
+                        normals.col(p) =
+                            unit_normal(projector, placement.points[static_cast<size_t>(p)],
+                                        placement.positions.col(p));
+                      }
+                    });
+  return normals;
+}
+
+// Step 2 of the file comment: the source region's centre and frame, and every particle's tangent
+// coordinates.
+void source_frame(const Region& region, const ParticleGrid& grid, DecalGeometry& g) {
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero(), normal = Eigen::Vector3d::Zero();
+  double area = 0.0;
+  for (const Eigen::Vector3i& t : region.triangles) {
+    const Eigen::Vector3d& a = region.positions[static_cast<size_t>(t[0])];
+    const Eigen::Vector3d& b = region.positions[static_cast<size_t>(t[1])];
+    const Eigen::Vector3d& c = region.positions[static_cast<size_t>(t[2])];
+    const Eigen::Vector3d cross = (b - a).cross(c - a);
+    const double twice = cross.norm();
+    centre += twice * (a + b + c) / 3.0;
+    normal += cross;
+    area += twice;
+  }
+  if (!(area > 0.0) || !(normal.norm() > 0.0)) {
+    throw InvalidInputError("source region", "has no area to place as a decal");
+  }
+  g.source_centre = centre / area;
+  g.source_frame = world_up_frame(normal.normalized());
+  const Eigen::Matrix3Xd x = grid.source_positions();
+  g.source_coordinates.resize(static_cast<size_t>(x.cols()));
+  double nearest = std::numeric_limits<double>::infinity();
+  for (Eigen::Index p = 0; p < x.cols(); ++p) {
+    const Eigen::Vector3d d = x.col(p) - g.source_centre;
+    const Eigen::Vector2d u(d.dot(g.source_frame.right), d.dot(g.source_frame.up));
+    g.source_coordinates[static_cast<size_t>(p)] = u;
+    g.source_radius = std::max(g.source_radius, u.norm());
+    if (u.norm() < nearest) {
+      nearest = u.norm();
+      g.pinned = static_cast<int>(p);
+    }
+  }
+  double sum = 0.0;
+  for (const Spring& s : grid.springs) sum += s.rest;
+  const double spacing =
+      grid.springs.empty() ? 0.0 : sum / static_cast<double>(grid.springs.size());
+  const Eigen::Vector2d above =
+      g.source_coordinates[static_cast<size_t>(g.pinned)] + Eigen::Vector2d(0.0, spacing);
+  nearest = std::numeric_limits<double>::infinity();
+  for (size_t p = 0; p < g.source_coordinates.size(); ++p) {
+    const double d = (g.source_coordinates[p] - above).norm();
+    if (static_cast<int>(p) != g.pinned && d < nearest) {
+      nearest = d;
+      g.pinned_up = static_cast<int>(p);
+    }
+  }
+}
+
+// Step 3: the target centre and the frame there, turned by the placement's angle.
+void target_frame(const SurfaceProjector& target, const MapDecalOptions& options,
+                  DecalGeometry& g) {
+  const Eigen::Vector3d& point = g.placement.point;
+  const ClosestPoint closest = target.closest(point);
+  const LimitTessellation& tessellation = target.tessellation();
+  Eigen::Vector3d low = tessellation.positions.front(), high = low;
+  for (const Eigen::Vector3d& x : tessellation.positions) {
+    low = low.cwiseMin(x);
+    high = high.cwiseMax(x);
+  }
+  const double diagonal = (high - low).norm();
+  if (closest.distance > options.max_point_distance * diagonal) {
+    throw InvalidInputError(options.name, "the point " + number(point.x()) + "," +
+                                              number(point.y()) + "," + number(point.z()) + " is " +
+                                              number(closest.distance) +
+                                              " from the target surface (at most " +
+                                              number(options.max_point_distance * diagonal) + ")");
+  }
+  g.target_centre = closest.point;
+  g.target_centre_position = closest.position;
+  const UpFrame frame = world_up_frame(unit_normal(target, closest.point, closest.position));
+  const double a = g.placement.angle_degrees * std::numbers::pi / 180.0;
+  g.target_frame.normal = frame.normal;
+  g.target_frame.right = std::cos(a) * frame.right + std::sin(a) * frame.up;
+  g.target_frame.up = -std::sin(a) * frame.right + std::cos(a) * frame.up;
+}
+
+// The area-weighted mean turn (degrees, counter-clockwise about the pinned particle's normal) from
+// `start` to `end`.
+double turn_degrees(const DecalGeometry& g, const Eigen::Matrix3Xd& start,
+                    const Eigen::Matrix3Xd& end, const Eigen::Vector3d& normal) {
+  const int pin = g.pinned;
+  double sum = 0.0, weight = 0.0;
+  for (Eigen::Index p = 0; p < start.cols(); ++p) {
+    const double r = g.source_coordinates[static_cast<size_t>(p)].norm();
+    if (p == pin || r < 0.25 * g.source_radius) continue;
+    Eigen::Vector3d a = start.col(p) - start.col(pin), b = end.col(p) - end.col(pin);
+    a -= normal * normal.dot(a);
+    b -= normal * normal.dot(b);
+    sum += r * r * std::atan2(normal.dot(a.cross(b)), a.dot(b));
+    weight += r * r;
+  }
+  return weight > 0.0 ? sum / weight * 180.0 / std::numbers::pi : 0.0;
+}
+
+void check_no_overlap(const ParticleGrid& grid, const InitialMap& placement,
+                      const SurfaceProjector& target, const DecalGeometry& g,
+                      const std::string& name, const char* when) {
+  const std::vector<int> overlapping =
+      self_overlapping_particles(grid, placement.positions, unit_normals(target, placement));
+  if (overlapping.empty()) return;
+  double inner = g.source_radius;
+  for (const int p : overlapping) {
+    inner = std::min(inner, g.source_coordinates[static_cast<size_t>(p)].norm());
+  }
+  const double most = 0.9 * g.placement.scale * inner / g.source_radius;
+  throw InvalidInputError(
+      name, std::string("the decal overlaps itself on the target ") + when + " (" +
+                std::to_string(overlapping.size()) +
+                " particles lie on another part of it: it wraps around a thin part or covers too "
+                "much of a closed surface); make it smaller: SCALE at most about " +
+                number(most) + " (now " + number(g.placement.scale) + ")");
+}
+
+// Step 5: the target region cut along the relaxed boundary.
+std::unique_ptr<Region> cut_target_region(const SurfaceProjector& target, const ParticleGrid& grid,
+                                          const RelaxationResult& relaxed, const DecalGeometry& g,
+                                          const std::string& name) {
+  RegionSpec spec;
+  spec.kind = RegionSpec::Kind::Points;
+  spec.text = "the decal's relaxed boundary";
+  for (const int p : grid.boundary_loop) spec.points.emplace_back(relaxed.positions.col(p));
+  spec.anchor = spec.points.front();
+  std::unique_ptr<Region> region;
+  try {
+    region = std::make_unique<Region>(
+        make_region(target, spec, {.name = name, .euclidean_bands = true}));
+  } catch (const InvalidInputError& e) {
+    throw InvalidInputError(name, std::string("the decal's boundary does not bound a disk on the "
+                                              "target (") +
+                                      e.problem() + "); make it smaller");
+  }
+  // The region is the disk side of the curve (the smaller one on a closed genus-0 surface): the
+  // decal must be that side.
+  const RegionDiskMap disk(*region);
+  Eigen::Vector2d z;
+  if (!disk.to_disk(relaxed.points[static_cast<size_t>(g.pinned)], z)) {
+    throw InvalidInputError(name,
+                            "the decal covers more than half of the closed target surface; make "
+                            "it smaller: SCALE at most about " +
+                                number(0.7 * g.placement.scale) + " (now " +
+                                number(g.placement.scale) + ")");
+  }
+  return region;
+}
+
+}  // namespace
+
+DecalPlacement parse_decal_placement(const std::string& text, const std::string& input) {
+  std::vector<double> values;
+  std::string item;
+  std::istringstream in(text);
+  const auto bad = [&] {
+    return InvalidInputError(input,
+                             "expected X,Y,Z[,ANGLE_DEG[,SCALE]] (finite numbers, "
+                             "SCALE > 0), got '" +
+                                 text + "'");
+  };
+  while (std::getline(in, item, ',')) {
+    std::size_t used = 0;
+    double value = 0.0;
+    try {
+      value = std::stod(item, &used);
+    } catch (const std::exception&) {
+      throw bad();
+    }
+    if (used != item.size() || !std::isfinite(value)) throw bad();
+    values.push_back(value);
+  }
+  const auto commas = static_cast<size_t>(std::count(text.begin(), text.end(), ','));
+  if (values.size() < 3 || values.size() > 5 || commas + 1 != values.size()) throw bad();
+  DecalPlacement placement;
+  placement.point = {values[0], values[1], values[2]};
+  if (values.size() > 3) placement.angle_degrees = values[3];
+  if (values.size() > 4) placement.scale = values[4];
+  if (!(placement.scale > 0.0)) throw bad();
+  return placement;
+}
+
+InitialMap exponential_map_placement(const LimitSurface& target, const DecalGeometry& g,
+                                     const ExponentialMapOptions& options,
+                                     std::vector<double>* reached) {
+  const auto P = g.source_coordinates.size();
+  InitialMap out;
+  out.positions.resize(3, static_cast<Eigen::Index>(P));
+  out.points.resize(P);
+  std::vector<double> fraction(P, 1.0);
+  const double scale = g.placement.scale;
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, P, 16), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t p = r.begin(); p != r.end(); ++p) {
+      const Eigen::Vector2d& u = g.source_coordinates[p];
+      const Eigen::Vector3d v = scale * (u.x() * g.target_frame.right + u.y() * g.target_frame.up);
+      const GeodesicShot shot = exponential_map(target, g.target_centre, v, options);
+      out.points[p] = shot.point;
+      out.positions.col(static_cast<Eigen::Index>(p)) = shot.position;
+      if (shot.hit_boundary) fraction[p] = v.norm() > 0.0 ? shot.length / v.norm() : 1.0;
+    }
+  });
+  if (reached != nullptr) *reached = std::move(fraction);
+  return out;
+}
+
+std::vector<int> self_overlapping_particles(const ParticleGrid& grid,
+                                            const Eigen::Matrix3Xd& positions,
+                                            const Eigen::Matrix3Xd& normals) {
+  // The grid's faces as fans of triangles, hashed by their bounding boxes on a uniform grid of
+  // cells one longest edge wide.
+  std::vector<Eigen::Vector3i> triangles;
+  double longest = 0.0;
+  for (const auto f : grid.mesh.faces()) {
+    std::vector<int> corners;
+    for (const auto v : grid.mesh.fv_range(f)) corners.push_back(v.idx());
+    for (size_t k = 1; k + 1 < corners.size(); ++k) {
+      triangles.emplace_back(corners[0], corners[k], corners[k + 1]);
+    }
+    for (size_t k = 0; k < corners.size(); ++k) {
+      longest = std::max(
+          longest,
+          (positions.col(corners[k]) - positions.col(corners[(k + 1) % corners.size()])).norm());
+    }
+  }
+  if (!(longest > 0.0)) return {};
+  const double cell = longest;
+  const auto key = [&](const Eigen::Vector3d& x) {
+    const Eigen::Vector3d c = (x / cell).array().floor();
+    const auto h = [](double v) {
+      return static_cast<std::uint64_t>(static_cast<std::int64_t>(v));
+    };
+    return (h(c.x()) * 73856093ULL) ^ (h(c.y()) * 19349663ULL) ^ (h(c.z()) * 83492791ULL);
+  };
+  std::unordered_multimap<std::uint64_t, int> cells;
+  for (size_t t = 0; t < triangles.size(); ++t) {
+    Eigen::Vector3d low = positions.col(triangles[t][0]), high = low;
+    for (int k = 1; k < 3; ++k) {
+      low = low.cwiseMin(positions.col(triangles[t][k]));
+      high = high.cwiseMax(positions.col(triangles[t][k]));
+    }
+    const Eigen::Vector3d a = (low / cell).array().floor(), b = (high / cell).array().floor();
+    for (double x = a.x(); x <= b.x(); ++x) {
+      for (double y = a.y(); y <= b.y(); ++y) {
+        for (double z = a.z(); z <= b.z(); ++z) {
+          cells.emplace(key(Eigen::Vector3d(x + 0.5, y + 0.5, z + 0.5) * cell),
+                        static_cast<int>(t));
+        }
+      }
+    }
+  }
+  std::vector<int> out;
+  for (Eigen::Index p = 0; p < positions.cols(); ++p) {
+    const Eigen::Vector3d x = positions.col(p);
+    const auto [first, last] = cells.equal_range(key(x));
+    for (auto it = first; it != last; ++it) {
+      const Eigen::Vector3i& t = triangles[static_cast<size_t>(it->second)];
+      if (t[0] == p || t[1] == p || t[2] == p) continue;
+      const Eigen::Vector3d a = positions.col(t[0]), b = positions.col(t[1]),
+                            c = positions.col(t[2]);
+      Eigen::Vector3d n = (b - a).cross(c - a);
+      const double twice = n.norm();
+      if (!(twice > 0.0)) continue;
+      n /= twice;
+      // Same side of the surface, and close to the triangle's plane (a thin part's other side
+      // faces away; a far sheet is far).
+      if (n.dot(normals.col(p)) < 0.5) continue;
+      const double edge = std::max({(b - a).norm(), (c - b).norm(), (a - c).norm()});
+      if (std::abs(n.dot(x - a)) > 0.5 * edge) continue;
+      // Strictly inside, by a margin: a fold-free neighbour's corner is outside.
+      const double wa = n.dot((b - x).cross(c - x)) / twice;
+      const double wb = n.dot((c - x).cross(a - x)) / twice;
+      const double wc = 1.0 - wa - wb;
+      if (wa > 0.01 && wb > 0.01 && wc > 0.01) {
+        out.push_back(static_cast<int>(p));
+        break;
+      }
+    }
+  }
+  return out;
+}
+
+MapDecalResult map_decal(const SurfaceProjector& source, const Region& source_region,
+                         const SurfaceProjector& target, const DecalPlacement& placement,
+                         const MapDecalOptions& options) {
+  if (source_region.surface != &source.surface()) {
+    throw InvalidInputError("source region", "does not lie on the source surface");
+  }
+  if (!placement.point.allFinite() || !std::isfinite(placement.angle_degrees) ||
+      !std::isfinite(placement.scale) || !(placement.scale > 0.0)) {
+    throw InvalidInputError(options.name, "the point, angle and scale must be finite, scale > 0");
+  }
+  auto stage = [&](std::string_view name) {
+    if (!report_progress(options.progress, {.stage = name})) {
+      throw Error("decal", "cancelled during " + std::string(name));
+    }
+  };
+  MapDecalResult result;
+  MapResult& map = result.map;
+  DecalGeometry& g = result.geometry;
+  g.placement = placement;
+
+  stage("sample");
+  auto start = std::chrono::steady_clock::now();
+  map.sampling = sample_region(source_region, source, options.sampling);
+  map.seconds_sampling = seconds_since(start);
+  const ParticleGrid& grid = map.sampling.grid;
+  map.sampled_particles = grid.num_particles();
+
+  stage("place");
+  start = std::chrono::steady_clock::now();
+  source_frame(source_region, grid, g);
+  target_frame(target, options, g);
+  map.rest_scale = placement.scale;
+  ExponentialMapOptions shooting = options.shooting;
+  if (shooting.step <= 0.0) {
+    double sum = 0.0;
+    for (const Spring& s : grid.springs) sum += s.rest;
+    shooting.step = grid.springs.empty()
+                        ? 0.0
+                        : 0.5 * placement.scale * sum / static_cast<double>(grid.springs.size());
+  }
+  std::vector<double> reached;
+  map.naive = exponential_map_placement(target.surface(), g, shooting, &reached);
+  const double reach = *std::min_element(reached.begin(), reached.end());
+  if (reach < 1.0) {
+    throw InvalidInputError(options.name,
+                            "the decal runs off the target surface's boundary; move it away from "
+                            "the edge or make it smaller: SCALE at most about " +
+                                number(0.9 * reach * placement.scale) + " (now " +
+                                number(placement.scale) + ")");
+  }
+  check_no_overlap(grid, map.naive, target, g, options.name, "where it is placed");
+  g.seconds_shooting = seconds_since(start);
+  map.seconds_naive = g.seconds_shooting;
+
+  stage("relax");
+  RelaxationProblem problem;
+  problem.grid = &grid;
+  problem.target = &target;
+  problem.initial_positions = map.naive.positions;
+  problem.initial_points = map.naive.points;
+  problem.rest_scale = placement.scale;
+  problem.rest_scale_mode = RestScale::None;
+  problem.pinned = {g.pinned, g.pinned_up};
+  RelaxationOptions relaxation = options.relaxation;
+  relaxation.boundary = BoundaryMode::Free;
+  map.relaxation = relax(problem, relaxation);
+  if (map.relaxation.reason == StopReason::Cancelled) {
+    throw Error("decal", "cancelled during relax");
+  }
+  const InitialMap relaxed{map.relaxation.positions, map.relaxation.points, 0};
+  check_no_overlap(grid, relaxed, target, g, options.name, "after relaxing");
+  g.turned_degrees =
+      turn_degrees(g, map.naive.positions, map.relaxation.positions, g.target_frame.normal);
+
+  stage("cut");
+  start = std::chrono::steady_clock::now();
+  result.target_region = cut_target_region(target, grid, map.relaxation, g, options.name);
+  map.source_disk = std::make_unique<RegionDiskMap>(source_region);
+  map.target_disk = std::make_unique<RegionDiskMap>(*result.target_region);
+  g.seconds_cut = seconds_since(start);
+
+  stage("mapping");
+  start = std::chrono::steady_clock::now();
+  map.mapping =
+      Mapping(grid, source, *map.source_disk, target, *map.target_disk, map.relaxation.points);
+  map.seconds_mapping = seconds_since(start);
+  return result;
+}
+
+}  // namespace elastic
