@@ -4,6 +4,7 @@
 #include <iomanip>
 #include <sstream>
 
+#include "elastic/baselines/decal_baseline.h"
 #include "elastic/core/error.h"
 #include "elastic/mesh/mesh_io.h"
 
@@ -50,7 +51,16 @@ std::vector<MethodMeasurement> compare_methods(const MapSession& session,
   naive.seconds = r.seconds_naive;
   out.push_back(std::move(naive));
 
-  for (const BaselineKind kind : options.baselines) {
+  if (session.decal) {
+    // A placed decal has no drawn target curve for the flattening baselines: its baseline is the
+    // decal of the same kind, the exponential map, on the same grid.
+    const DecalBaselineResult b = exponential_map_decal(*session.target.surface, *session.decal);
+    MethodMeasurement m = measure(session, "expmap", b.positions, b.points, {});
+    m.seconds = b.seconds;
+    m.extra = {{"stopped_at_boundary", b.stopped}};
+    out.push_back(std::move(m));
+  }
+  for (const BaselineKind kind : session.decal ? std::vector<BaselineKind>{} : options.baselines) {
     const std::string name(to_string(kind));
     try {
       BaselineOptions baseline_options;

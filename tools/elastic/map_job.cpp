@@ -23,6 +23,25 @@ double seconds_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
+/// A placed decal's placement (null for a drawn target region).
+nlohmann::json decal_report(const MapSession& session) {
+  if (!session.decal) return nullptr;
+  const DecalGeometry& g = *session.decal;
+  const auto vec = [](const Eigen::Vector3d& v) { return nlohmann::json{v.x(), v.y(), v.z()}; };
+  return {{"point", vec(g.placement.point)},
+          {"angle_deg", g.placement.angle_degrees},
+          {"scale", g.placement.scale},
+          {"centre", vec(g.target_centre_position)},
+          {"up", vec(g.target_frame.up)},
+          {"normal", vec(g.target_frame.normal)},
+          {"source_centre", vec(g.source_centre)},
+          {"source_radius", g.source_radius},
+          {"turned_deg", g.turned_degrees},
+          {"target_area", session.target_region.area()},
+          {"seconds_shooting", g.seconds_shooting},
+          {"seconds_cut", g.seconds_cut}};
+}
+
 /// The subdivision step after the map (end of §4.3): one entry per level.
 nlohmann::json subdivision_report(const MapResult& r) {
   nlohmann::json levels = nlohmann::json::array();
@@ -45,6 +64,39 @@ nlohmann::json subdivision_report(const MapResult& r) {
           {"iterations", r.subdivision_iterations},
           {"seconds", r.seconds_subdivision},
           {"per_level", levels}};
+}
+
+// The flags of a drawn target region's map that a placed decal has no use for: refused rather
+// than ignored.
+void check_decal_flags(const MapJob& job) {
+  const auto refuse = [](bool given, const std::string& flag, const std::string& why) {
+    if (given) throw UsageError(flag + " does not apply to --target-place: " + why);
+  };
+  refuse(job.rest_scale != "auto", "--rest-scale", "the decal's size is its SCALE");
+  refuse(job.boundary != "auto", "--boundary", "a placed decal's boundary is free");
+  refuse(job.boundary_offset != "auto", "--boundary-offset", "a placed decal has no target curve");
+  refuse(job.subdivide != 0, "--subdivide", "not available for placed decals yet");
+}
+
+// A placed decal (--target-place): map_decal, its cut region kept in the session.
+void run_decal(const MapJob& job, const MapOptions& options, MapSession& s) {
+  check_decal_flags(job);
+  DecalPlacement placement;
+  try {
+    placement = parse_decal_placement(job.target_place, "--target-place");
+  } catch (const InvalidInputError& e) {
+    throw UsageError(e.what());
+  }
+  MapDecalOptions decal;
+  decal.sampling = options.sampling;
+  decal.relaxation = options.relaxation;
+  decal.progress = options.progress;
+  MapDecalResult placed =
+      map_decal(*s.source.projector, s.source_region, *s.target.projector, placement, decal);
+  s.result = std::move(placed.map);
+  s.decal = std::move(placed.geometry);
+  s.placed_region = std::move(placed.target_region);
+  s.target_region = *s.placed_region;
 }
 
 }  // namespace
@@ -74,8 +126,17 @@ void add_map_flags(CLI::App& sub, MapJob& a) {
                  "Source region: disk:X,Y,Z,R | points:FILE | boundary | uv:FILE");
   sub.add_option("--source-anchor", a.source_anchor, "X,Y,Z: start of the boundary correspondence");
   sub.add_option("--target", a.target, "Target mesh file (required)");
-  sub.add_option("--target-region", a.target_region, "Target region (same forms)");
-  sub.add_option("--target-anchor", a.target_anchor, "X,Y,Z: start of the boundary correspondence");
+  CLI::Option* target_region =
+      sub.add_option("--target-region", a.target_region, "Target region (same forms)");
+  CLI::Option* target_anchor = sub.add_option("--target-anchor", a.target_anchor,
+                                              "X,Y,Z: start of the boundary correspondence");
+  sub.add_option("--target-place", a.target_place,
+                 "X,Y,Z[,ANGLE_DEG[,SCALE]]: instead of --target-region, place the source as a "
+                 "decal with a free boundary: its centre on the target point closest to X,Y,Z, "
+                 "its up ANGLE_DEG counter-clockwise from the world +Y projected on the surface "
+                 "(default 0), SCALE times its own size (default 1)")
+      ->excludes(target_region)
+      ->excludes(target_anchor);
   sub.add_option("--particles", a.particles, "Number of particles (within 5%), 16..5000000")
       ->check(CLI::Range(kMinParticles, kMaxParticles));
   sub.add_option("--solver", a.solver, "lbfgs (fast) or explicit (the paper's integrator)")
@@ -243,18 +304,22 @@ std::unique_ptr<MapSession> run_map_job(const MapJob& job, const ProgressCallbac
       s.image ? s.image->region : parse_region_flag(job.source_region, "--source-region");
   if (!job.source_anchor.empty())
     source_spec.anchor = parse_point(job.source_anchor, "--source-anchor");
-  RegionSpec target_spec = parse_region_flag(job.target_region, "--target-region");
-  if (!job.target_anchor.empty())
-    target_spec.anchor = parse_point(job.target_anchor, "--target-anchor");
   s.source_region = make_region(*s.source.projector, source_spec, {.name = "--source-region"});
-  s.target_region = make_region(*s.target.projector, target_spec, {.name = "--target-region"});
-  s.seconds_loading = seconds_since(start);
-
   MapOptions options = make_map_options(job, progress);
   options.relaxation.frame = frame;
   options.relaxation.frame_interval = std::max(1L, frame_interval);
-  s.result = map_regions(*s.source.projector, s.source_region, *s.target.projector, s.target_region,
-                         options);
+  if (!job.target_place.empty()) {
+    s.seconds_loading = seconds_since(start);
+    run_decal(job, options, s);
+  } else {
+    RegionSpec target_spec = parse_region_flag(job.target_region, "--target-region");
+    if (!job.target_anchor.empty())
+      target_spec.anchor = parse_point(job.target_anchor, "--target-anchor");
+    s.target_region = make_region(*s.target.projector, target_spec, {.name = "--target-region"});
+    s.seconds_loading = seconds_since(start);
+    s.result = map_regions(*s.source.projector, s.source_region, *s.target.projector,
+                           s.target_region, options);
+  }
   s.metrics = measure_placement(s, s.result.relaxation.positions, s.result.relaxation.points);
   s.naive_metrics = measure_placement(s, s.result.naive.positions, s.result.naive.points);
   s.seconds_total = seconds_since(start);
@@ -338,6 +403,7 @@ nlohmann::json map_report(const MapJob& job, const MapSession& session,
         {"naive_energy_at_zero", r.offset_energy_at_zero},
         {"naive_folds", r.offset_folds}}},
       {"subdivision", subdivision_report(r)},
+      {"decal", decal_report(session)},
       {"sampling",
        {{"spacing_min", s.spacing_min},
         {"spacing_median", s.spacing_median},

@@ -18,6 +18,7 @@
 #include <string>
 
 #include "cli_common.h"
+#include "elastic/mapping/map_decal.h"
 #include "elastic/mapping/map_regions.h"
 #include "elastic/metrics/map_metrics.h"
 #include "elastic/regions/image_source.h"
@@ -26,14 +27,17 @@
 namespace elastic::cli {
 
 struct MapJob {
-  std::string source;                        ///< --source MESH
-  std::string source_image;                  ///< --source-image IMAGE (a plane carrying the image)
-  double image_width = 2.0;                  ///< --image-width: physical width of the image's plane
-  std::string source_region = "boundary";    ///< --source-region SPEC
-  std::string source_anchor;                 ///< --source-anchor X,Y,Z
-  std::string target;                        ///< --target MESH (required)
-  std::string target_region = "boundary";    ///< --target-region SPEC
-  std::string target_anchor;                 ///< --target-anchor X,Y,Z
+  std::string source;                      ///< --source MESH
+  std::string source_image;                ///< --source-image IMAGE (a plane carrying the image)
+  double image_width = 2.0;                ///< --image-width: physical width of the image's plane
+  std::string source_region = "boundary";  ///< --source-region SPEC
+  std::string source_anchor;               ///< --source-anchor X,Y,Z
+  std::string target;                      ///< --target MESH (required)
+  std::string target_region = "boundary";  ///< --target-region SPEC
+  std::string target_anchor;               ///< --target-anchor X,Y,Z
+  /// --target-place X,Y,Z[,ANGLE_DEG[,SCALE]]: a decal with a free boundary instead of a drawn
+  /// target region (mapping/map_decal.h)
+  std::string target_place;
   long particles = 1000;                     ///< --particles N
   std::string solver = "lbfgs";              ///< --solver lbfgs|explicit
   std::string preconditioner = "multigrid";  ///< --preconditioner multigrid|direct (lbfgs)
@@ -82,8 +86,13 @@ struct MapSession {
   LoadedSurface source;
   LoadedSurface target;
   Region source_region;
+  /// The target region: drawn (--target-region), or for a placed decal (--target-place) a copy
+  /// of the region cut along its relaxed boundary.
   Region target_region;
   MapResult result;
+  /// A placed decal: its placement and frames, and the cut region the Mapping references.
+  std::optional<DecalGeometry> decal;
+  std::unique_ptr<Region> placed_region;
   /// The final map (result.relaxation) and the naive map measured on the grid by docs/metrics.md:
   /// the one fold count (`folds`) every report and summary shows, and the verdict's.
   MapMetrics metrics;

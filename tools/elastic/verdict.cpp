@@ -63,8 +63,12 @@ MapVerdict judge_map(const MapJob& job, const MapSession& session) {
     advice.push_back("--source-region ellipse");
   }
   if (job.energy == "paper") advice.push_back("--energy robust");
-  if (job.rest_scale != "area") advice.push_back("--rest-scale area");
-  advice.push_back(job.boundary == "fixed" ? "--boundary slide" : "--boundary fixed");
+  if (!job.target_place.empty()) {
+    advice.push_back("a smaller SCALE in --target-place");  // a free boundary: no curve to change
+  } else {
+    if (job.rest_scale != "area") advice.push_back("--rest-scale area");
+    advice.push_back(job.boundary == "fixed" ? "--boundary slide" : "--boundary fixed");
+  }
   v.advice = join_choices(advice);
   return v;
 }
