@@ -289,6 +289,39 @@ TEST(PointsRegion, CornersOnTessellationEdgesKeepTheSidesStraight) {
   EXPECT_LT(worst, 1e-3);
 }
 
+// RegionOptions::euclidean_bands: a polygon of 48 close points on a sphere (a small circle) is
+// the same region whether each side's shortest path is searched in the heat method's band or in
+// the band of 3D distances; so is a polygon whose points are far apart (the 3D band falls back).
+TEST(PointsRegion, EuclideanBandsGiveTheSameRegion) {
+  const Fixture fx(make_sphere({.faces = ShapeFaces::Quads, .resolution = 12}), 6);
+  const Eigen::Vector3d centre = Eigen::Vector3d(0.3, 0.5, 0.8).normalized();
+  const Eigen::Vector3d a = centre.cross(Eigen::Vector3d::UnitX()).normalized();
+  const Eigen::Vector3d b = centre.cross(a);
+  std::vector<Eigen::Vector3d> circle;
+  for (int k = 0; k < 48; ++k) {
+    const double t = 2.0 * kPi * k / 48.0;
+    circle.push_back(fx.on_surface(centre + 0.6 * (std::cos(t) * a + std::sin(t) * b)));
+  }
+  for (const auto& polygon :
+       {circle, std::vector<Eigen::Vector3d>{fx.on_surface({1, 0.2, 0.2}),
+                                             fx.on_surface({0.2, 1, 0.2}),
+                                             fx.on_surface({0.2, 0.2, 1})}}) {
+    const Region heat = make_region(*fx.projector, points(polygon));
+    const Region chords =
+        make_region(*fx.projector, points(polygon), {.name = "chords", .euclidean_bands = true});
+    expect_consistent(chords);
+    EXPECT_NEAR(chords.area(), heat.area(), 1e-12 * heat.area());
+    ASSERT_EQ(chords.boundary.size(), heat.boundary.size());
+    double worst = 0.0;
+    for (size_t k = 0; k < heat.boundary.size(); ++k) {
+      worst = std::max(worst, (chords.positions[static_cast<size_t>(chords.boundary[k])] -
+                               heat.positions[static_cast<size_t>(heat.boundary[k])])
+                                  .norm());
+    }
+    EXPECT_LT(worst, 1e-12);
+  }
+}
+
 TEST(PointsRegion, SphereTriangleIsOrientedAndSmallerSide) {
   const Fixture fx(make_sphere({.faces = ShapeFaces::Quads, .resolution = 6}), 6);
   const Region region =

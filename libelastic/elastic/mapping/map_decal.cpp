@@ -168,7 +168,7 @@ void check_no_overlap(const ParticleGrid& grid, const InitialMap& placement,
 
 // Step 5: the target region cut along the relaxed boundary.
 std::unique_ptr<Region> cut_target_region(const SurfaceProjector& target, const ParticleGrid& grid,
-                                          const RelaxationResult& relaxed, const DecalGeometry& g,
+                                          const RelaxationResult& relaxed,
                                           const std::string& name) {
   RegionSpec spec;
   spec.kind = RegionSpec::Kind::Points;
@@ -184,9 +184,13 @@ std::unique_ptr<Region> cut_target_region(const SurfaceProjector& target, const 
                                               "target (") +
                                       e.problem() + "); make it smaller");
   }
-  // The region is the disk side of the curve (the smaller one on a closed genus-0 surface): the
-  // decal must be that side.
-  const RegionDiskMap disk(*region);
+  return region;
+}
+
+// The region is the disk side of the curve (the smaller one on a closed genus-0 surface): the
+// decal must be that side.
+void check_decal_side(const RegionDiskMap& disk, const RelaxationResult& relaxed,
+                      const DecalGeometry& g, const std::string& name) {
   Eigen::Vector2d z;
   if (!disk.to_disk(relaxed.points[static_cast<size_t>(g.pinned)], z)) {
     throw InvalidInputError(name,
@@ -195,7 +199,6 @@ std::unique_ptr<Region> cut_target_region(const SurfaceProjector& target, const 
                                 number(0.7 * g.placement.scale) + " (now " +
                                 number(g.placement.scale) + ")");
   }
-  return region;
 }
 
 }  // namespace
@@ -406,9 +409,10 @@ MapDecalResult map_decal(const SurfaceProjector& source, const Region& source_re
 
   stage("cut");
   start = std::chrono::steady_clock::now();
-  result.target_region = cut_target_region(target, grid, map.relaxation, g, options.name);
+  result.target_region = cut_target_region(target, grid, map.relaxation, options.name);
   map.source_disk = std::make_unique<RegionDiskMap>(source_region);
   map.target_disk = std::make_unique<RegionDiskMap>(*result.target_region);
+  check_decal_side(*map.target_disk, map.relaxation, g, options.name);
   g.seconds_cut = seconds_since(start);
 
   stage("mapping");

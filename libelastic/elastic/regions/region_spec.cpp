@@ -8,6 +8,7 @@
 #include <functional>
 #include <limits>
 #include <sstream>
+#include <unordered_map>
 
 #include "elastic/core/error.h"
 #include "elastic/projection/closest_point.h"
@@ -423,17 +424,7 @@ class SideBands {
   SideBands(const Context& ctx, const std::vector<MeshLocation>& locs,
             const std::vector<Eigen::Vector3d>& where)
       : ctx_(ctx), locs_(locs), where_(where) {
-    double sum = 0.0;
-    for (const Eigen::Vector3i& t : ctx.tess.triangles) {
-      for (int k = 0; k < 3; ++k) {
-        sum += (ctx.tess.positions[static_cast<size_t>(t[k])] -
-                ctx.tess.positions[static_cast<size_t>(t[(k + 1) % 3])])
-                   .norm();
-      }
-    }
-    mean_edge_ = ctx.tess.triangles.empty()
-                     ? 0.0
-                     : sum / (3.0 * static_cast<double>(ctx.tess.triangles.size()));
+    if (ctx.options.euclidean_bands) index_vertices();
   }
 
   std::vector<char> heat(size_t i, size_t j) {
@@ -449,21 +440,77 @@ class SideBands {
                                          4.0 * heat_->mean_edge_length());
   }
 
+  /// The triangles with a corner v whose distances to the two ends add up to at most the bound
+  /// (geodesic_band's rule with 3D distances), found among the vertices near the first end.
   std::vector<char> euclidean(size_t i, size_t j) const {
-    const std::vector<Eigen::Vector3d>& x = ctx_.tess.positions;
-    Eigen::VectorXd from(static_cast<Eigen::Index>(x.size())), to(from.size());
-    for (size_t v = 0; v < x.size(); ++v) {
-      from[static_cast<Eigen::Index>(v)] = (x[v] - where_[i]).norm();
-      to[static_cast<Eigen::Index>(v)] = (x[v] - where_[j]).norm();
+    const Eigen::Vector3d& a = where_[i];
+    const Eigen::Vector3d& b = where_[j];
+    const double bound = this->bound(i, j);
+    std::vector<char> band(ctx_.tess.triangles.size(), 0);
+    const Eigen::Vector3i c = cell(a);
+    for (int dx = -1; dx <= 1; ++dx) {
+      for (int dy = -1; dy <= 1; ++dy) {
+        for (int dz = -1; dz <= 1; ++dz) {
+          const auto found = cells_.find(key(c + Eigen::Vector3i(dx, dy, dz)));
+          if (found == cells_.end()) continue;
+          for (const int v : found->second) {
+            const Eigen::Vector3d& x = ctx_.tess.positions[static_cast<size_t>(v)];
+            if ((x - a).norm() + (x - b).norm() > bound) continue;
+            for (const int t : vertex_triangles_[static_cast<size_t>(v)]) {
+              band[static_cast<size_t>(t)] = 1;
+            }
+          }
+        }
+      }
     }
-    return regions_detail::geodesic_band(ctx_.tess.triangles, from, to, 0.5, 4.0 * mean_edge_);
+    return band;
   }
 
  private:
+  double bound(size_t i, size_t j) const {
+    return 1.5 * (where_[i] - where_[j]).norm() + 4.0 * mean_edge_;
+  }
+  Eigen::Vector3i cell(const Eigen::Vector3d& x) const {
+    return (x / cell_size_).array().floor().cast<int>();
+  }
+  static std::uint64_t key(const Eigen::Vector3i& c) {
+    const auto h = [](int v) { return static_cast<std::uint64_t>(static_cast<std::uint32_t>(v)); };
+    return (h(c.x()) * 73856093ULL) ^ (h(c.y()) * 19349663ULL) ^ (h(c.z()) * 83492791ULL);
+  }
+
+  // Vertices hashed in cells at least as wide as any side's bound (a vertex within the bound of
+  // the first end is in its cell or a neighbour), and each vertex's triangles.
+  void index_vertices() {
+    const auto& x = ctx_.tess.positions;
+    const auto& triangles = ctx_.tess.triangles;
+    double sum = 0.0;
+    vertex_triangles_.resize(x.size());
+    for (size_t t = 0; t < triangles.size(); ++t) {
+      for (int k = 0; k < 3; ++k) {
+        sum += (x[static_cast<size_t>(triangles[t][k])] -
+                x[static_cast<size_t>(triangles[t][(k + 1) % 3])])
+                   .norm();
+        vertex_triangles_[static_cast<size_t>(triangles[t][k])].push_back(static_cast<int>(t));
+      }
+    }
+    mean_edge_ = triangles.empty() ? 0.0 : sum / (3.0 * static_cast<double>(triangles.size()));
+    cell_size_ = 4.0 * mean_edge_;
+    for (size_t i = 0; i < where_.size(); ++i) {
+      cell_size_ = std::max(cell_size_, bound(i, (i + 1) % where_.size()));
+    }
+    if (!(cell_size_ > 0.0)) cell_size_ = 1.0;
+    for (size_t v = 0; v < x.size(); ++v) {
+      cells_[key(cell(x[v]))].push_back(static_cast<int>(v));
+    }
+  }
+
   const Context& ctx_;
   const std::vector<MeshLocation>& locs_;
   const std::vector<Eigen::Vector3d>& where_;
   double mean_edge_ = 0.0;
+  double cell_size_ = 1.0;
+  std::vector<std::vector<int>> vertex_triangles_;
+  std::unordered_map<std::uint64_t, std::vector<int>> cells_;
   std::unique_ptr<regions_detail::HeatGeodesics> heat_;
   std::vector<Eigen::VectorXd> dist_;
 };
