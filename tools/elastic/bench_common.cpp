@@ -38,7 +38,7 @@ nlohmann::json machine_json(int solver_threads) {
           {"date", utc_now()}};
 }
 
-nlohmann::json read_cases_file(const std::string& path) {
+nlohmann::json read_cases_file(const std::string& path, const std::vector<std::string>& arrays) {
   nlohmann::json cases_file;
   std::ifstream in(path);
   if (!in) throw IoError(path, "cannot open the cases file");
@@ -47,8 +47,10 @@ nlohmann::json read_cases_file(const std::string& path) {
   } catch (const nlohmann::json::exception& e) {
     throw InvalidInputError(path, std::string("not valid JSON: ") + e.what());
   }
-  if (!cases_file.is_object() || !cases_file.contains("cases") || !cases_file["cases"].is_array()) {
-    throw InvalidInputError(path, "expected an object with a \"cases\" array");
+  for (const std::string& key : arrays) {
+    if (!cases_file.is_object() || !cases_file.contains(key) || !cases_file[key].is_array()) {
+      throw InvalidInputError(path, "expected an object with a \"" + key + "\" array");
+    }
   }
   return cases_file;
 }

@@ -4,6 +4,7 @@
 
 #include <nlohmann/json.hpp>
 #include <string>
+#include <vector>
 
 namespace elastic::cli {
 
@@ -13,8 +14,9 @@ std::string cpu_model();
 std::string utc_now();
 /// {"cpu", "threads" (hardware), "solver_threads", "date"}.
 nlohmann::json machine_json(int solver_threads);
-/// Reads a cases file: a JSON object with a "cases" array.
+/// Reads a cases file: a JSON object with the given arrays ("cases" by default).
 /// \throws IoError when it cannot be opened; InvalidInputError when it is not such an object.
-nlohmann::json read_cases_file(const std::string& path);
+nlohmann::json read_cases_file(const std::string& path,
+                               const std::vector<std::string>& arrays = {"cases"});
 
 }  // namespace elastic::cli

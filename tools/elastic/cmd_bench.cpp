@@ -15,6 +15,7 @@
 #include <sstream>
 
 #include "bench_common.h"
+#include "bench_decals.h"
 #include "bench_robustness.h"
 #include "bench_scale.h"
 #include "cli_common.h"
@@ -383,7 +384,8 @@ int run_bench(const BenchArgs& args, const CLI::App& sub) {
 
 ELASTIC_COMMAND("bench",
                 "Benchmarks: `bench table1` (the paper's Table 1), `bench robustness` (real "
-                "inputs), `bench scale` (speed against CGAL's LSCM)",
+                "inputs), `bench scale` (speed against CGAL's LSCM), `bench decals` (placed "
+                "decals against the exponential map)",
                 [](CLI::App& sub) {
                   auto a = std::make_shared<elastic::cli::BenchArgs>();
                   sub.require_subcommand(1);
@@ -408,9 +410,12 @@ ELASTIC_COMMAND("bench",
                   CLI::App* scale_sub = nullptr;
                   const std::function<int()> scale = elastic::cli::add_scale_subcommand(sub);
                   scale_sub = sub.get_subcommand("scale");
-                  return [a, table1, robustness, scale, scale_sub] {
+                  const std::function<int()> decals = elastic::cli::add_decals_subcommand(sub);
+                  CLI::App* decals_sub = sub.get_subcommand("decals");
+                  return [a, table1, robustness, scale, scale_sub, decals, decals_sub] {
                     if (table1->parsed()) return elastic::cli::run_bench(*a, *table1);
                     if (scale_sub->parsed()) return scale();
+                    if (decals_sub->parsed()) return decals();
                     return robustness();
                   };
                 });
