@@ -37,6 +37,8 @@ nlohmann::json decal_report(const MapSession& session) {
           {"source_centre", vec(g.source_centre)},
           {"source_radius", g.source_radius},
           {"turned_deg", g.turned_degrees},
+          {"snapped_particles", g.snapped_particles},
+          {"snap_distance", g.snap_distance},
           {"target_area", session.target_region.area()},
           {"seconds_shooting", g.seconds_shooting},
           {"seconds_cut", g.seconds_cut}};

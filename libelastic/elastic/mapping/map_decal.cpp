@@ -149,7 +149,7 @@ double turn_degrees(const DecalGeometry& g, const Eigen::Matrix3Xd& start,
 
 void check_no_overlap(const ParticleGrid& grid, const InitialMap& placement,
                       const SurfaceProjector& target, const DecalGeometry& g,
-                      const std::string& name, const char* when) {
+                      const std::string& name) {
   const std::vector<int> overlapping =
       self_overlapping_particles(grid, placement.positions, unit_normals(target, placement));
   if (overlapping.empty()) return;
@@ -159,7 +159,7 @@ void check_no_overlap(const ParticleGrid& grid, const InitialMap& placement,
   }
   const double most = 0.9 * g.placement.scale * inner / g.source_radius;
   throw InvalidInputError(
-      name, std::string("the decal overlaps itself on the target ") + when + " (" +
+      name, std::string("the decal overlaps itself on the target (") +
                 std::to_string(overlapping.size()) +
                 " particles lie on another part of it: it wraps around a thin part or covers too "
                 "much of a closed surface); make it smaller: SCALE at most about " +
@@ -185,6 +185,43 @@ std::unique_ptr<Region> cut_target_region(const SurfaceProjector& target, const 
                                       e.problem() + "); make it smaller");
   }
   return region;
+}
+
+// The cut snaps curve points within 1e-3 of a tessellation triangle onto its edges and corners
+// (regions/region_spec.cpp), so a boundary particle, or an interior one a hair inside the chord
+// at a sharp tip, can end a snap's width outside the region. The queryable mapping needs every
+// particle inside: for the mapping (only), such a particle's point is the nearest boundary vertex
+// of the region; the relaxed map and its measurements keep the particle where it relaxed.
+// `points` gets the mapping's points; returns the largest move. A move beyond a quarter of the
+// grid spacing is not a snap and throws.
+double snap_into_region(const RegionDiskMap& disk, const Region& region, double spacing,
+                        const std::string& name, const RelaxationResult& relaxed,
+                        std::vector<SurfacePoint>& points, int& snapped) {
+  double largest = 0.0;
+  snapped = 0;
+  points = relaxed.points;
+  Eigen::Vector2d z;
+  for (size_t p = 0; p < relaxed.points.size(); ++p) {
+    if (disk.to_disk(relaxed.points[p], z)) continue;
+    const Eigen::Vector3d x = relaxed.positions.col(static_cast<Eigen::Index>(p));
+    int best = -1;
+    double nearest = std::numeric_limits<double>::infinity();
+    for (const int v : region.boundary) {
+      const double d = (region.positions[static_cast<size_t>(v)] - x).norm();
+      if (d < nearest) {
+        nearest = d;
+        best = v;
+      }
+    }
+    if (best < 0 || nearest > 0.25 * spacing) {
+      throw NumericalError(name, "particle " + std::to_string(p) +
+                                     " lies outside the region cut along the decal's boundary");
+    }
+    points[p] = region.points[static_cast<size_t>(best)];
+    largest = std::max(largest, nearest);
+    ++snapped;
+  }
+  return largest;
 }
 
 // The region is the disk side of the curve (the smaller one on a closed genus-0 surface): the
@@ -365,14 +402,13 @@ MapDecalResult map_decal(const SurfaceProjector& source, const Region& source_re
   source_frame(source_region, grid, g);
   target_frame(target, options, g);
   map.rest_scale = placement.scale;
+  // The grid's mean spacing on the target.
+  double sum = 0.0;
+  for (const Spring& s : grid.springs) sum += s.rest;
+  const double spacing =
+      grid.springs.empty() ? 0.0 : placement.scale * sum / static_cast<double>(grid.springs.size());
   ExponentialMapOptions shooting = options.shooting;
-  if (shooting.step <= 0.0) {
-    double sum = 0.0;
-    for (const Spring& s : grid.springs) sum += s.rest;
-    shooting.step = grid.springs.empty()
-                        ? 0.0
-                        : 0.5 * placement.scale * sum / static_cast<double>(grid.springs.size());
-  }
+  if (shooting.step <= 0.0) shooting.step = 0.5 * spacing;
   std::vector<double> reached;
   map.naive = exponential_map_placement(target.surface(), g, shooting, &reached);
   const double reach = *std::min_element(reached.begin(), reached.end());
@@ -383,7 +419,9 @@ MapDecalResult map_decal(const SurfaceProjector& source, const Region& source_re
                                 number(0.9 * reach * placement.scale) + " (now " +
                                 number(placement.scale) + ")");
   }
-  check_no_overlap(grid, map.naive, target, g, options.name, "where it is placed");
+  // The start is not checked for overlaps: where the exponential map folds (geodesics from the
+  // centre cross beyond a bump's conjugate points) the relaxation untangles it; a decal that
+  // truly wraps around a thin part still overlaps after relaxing, and is refused then.
   g.seconds_shooting = seconds_since(start);
   map.seconds_naive = g.seconds_shooting;
 
@@ -403,7 +441,7 @@ MapDecalResult map_decal(const SurfaceProjector& source, const Region& source_re
     throw Error("decal", "cancelled during relax");
   }
   const InitialMap relaxed{map.relaxation.positions, map.relaxation.points, 0};
-  check_no_overlap(grid, relaxed, target, g, options.name, "after relaxing");
+  check_no_overlap(grid, relaxed, target, g, options.name);
   g.turned_degrees =
       turn_degrees(g, map.naive.positions, map.relaxation.positions, g.target_frame.normal);
 
@@ -413,12 +451,14 @@ MapDecalResult map_decal(const SurfaceProjector& source, const Region& source_re
   map.source_disk = std::make_unique<RegionDiskMap>(source_region);
   map.target_disk = std::make_unique<RegionDiskMap>(*result.target_region);
   check_decal_side(*map.target_disk, map.relaxation, g, options.name);
+  std::vector<SurfacePoint> mapping_points;
+  g.snap_distance = snap_into_region(*map.target_disk, *result.target_region, spacing, options.name,
+                                     map.relaxation, mapping_points, g.snapped_particles);
   g.seconds_cut = seconds_since(start);
 
   stage("mapping");
   start = std::chrono::steady_clock::now();
-  map.mapping =
-      Mapping(grid, source, *map.source_disk, target, *map.target_disk, map.relaxation.points);
+  map.mapping = Mapping(grid, source, *map.source_disk, target, *map.target_disk, mapping_points);
   map.seconds_mapping = seconds_since(start);
   return result;
 }

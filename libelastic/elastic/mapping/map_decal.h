@@ -92,6 +92,11 @@ struct DecalGeometry {
   /// weighted by |u_i|^2 (0 on a plane; the pinned pair holds the centre's up direction exactly,
   /// this says how much the rest twists against it).
   double turned_degrees = 0.0;
+  /// Particles that the cut left a snap's width outside the region (see map_decal.cpp): the
+  /// queryable mapping puts them on the region's nearest boundary vertex (the relaxed map keeps
+  /// them); how many, and the largest such move.
+  int snapped_particles = 0;
+  double snap_distance = 0.0;
   double seconds_shooting = 0.0;  ///< the exponential-map start
   double seconds_cut = 0.0;       ///< cutting the target region along the relaxed boundary
 };
