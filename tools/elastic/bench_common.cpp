@@ -16,7 +16,9 @@ std::string cpu_model() {
   while (std::getline(in, line)) {
     if (line.rfind("model name", 0) == 0) {
       const auto colon = line.find(':');
-      if (colon != std::string::npos) return line.substr(colon + 2);
+      if (colon != std::string::npos) {
+        return line.substr(colon + 2);
+      }
     }
   }
   return "unknown";
@@ -41,7 +43,9 @@ nlohmann::json machine_json(int solver_threads) {
 nlohmann::json read_cases_file(const std::string& path, const std::vector<std::string>& arrays) {
   nlohmann::json cases_file;
   std::ifstream in(path);
-  if (!in) throw IoError(path, "cannot open the cases file");
+  if (!in) {
+    throw IoError(path, "cannot open the cases file");
+  }
   try {
     in >> cases_file;
   } catch (const nlohmann::json::exception& e) {

@@ -40,7 +40,9 @@ struct DecalArgs {
 };
 
 std::string fmt(double v, int digits = 3) {
-  if (!std::isfinite(v)) return std::isnan(v) ? "–" : (v > 0 ? "inf" : "-inf");
+  if (!std::isfinite(v)) {
+    return std::isnan(v) ? "–" : (v > 0 ? "inf" : "-inf");
+  }
   std::ostringstream o;
   o << std::setprecision(digits) << v;
   return o.str();
@@ -97,7 +99,9 @@ nlohmann::json figures(const nlohmann::json& m) {
                           "sigma_min", "seconds"}) {
     out[key] = m.contains(key) ? m[key] : nlohmann::json();
   }
-  if (m.contains("error")) out["error"] = m["error"];
+  if (m.contains("error")) {
+    out["error"] = m["error"];
+  }
   return out;
 }
 
@@ -121,13 +125,17 @@ nlohmann::json run_case(const nlohmann::json& source, const nlohmann::json& size
       {"target_place", place.str()},
       {"pass", false}};
   MapJob job;
-  if (source.contains("source")) job.source = path(source["source"].get<std::string>());
+  if (source.contains("source")) {
+    job.source = path(source["source"].get<std::string>());
+  }
   if (source.contains("source_image")) {
     job.source_image = path(source["source_image"].get<std::string>());
     job.image_width = source.value("image_width", job.image_width);
   }
   std::string region = source.value("source_region", "boundary");
-  if (region.rfind("points:", 0) == 0) region = "points:" + path(region.substr(7));
+  if (region.rfind("points:", 0) == 0) {
+    region = "points:" + path(region.substr(7));
+  }
   job.source_region = region;
   job.target = path(target.at("target").get<std::string>());
   job.target_place = place.str();
@@ -145,7 +153,9 @@ nlohmann::json run_case(const nlohmann::json& source, const nlohmann::json& size
     const MapVerdict verdict = judge_map(job, *session);
     const std::vector<MethodMeasurement> methods = compare_methods(*session);
     nlohmann::json m = nlohmann::json::object();
-    for (const MethodMeasurement& x : methods) m[x.name] = measurement_json(x);
+    for (const MethodMeasurement& x : methods) {
+      m[x.name] = measurement_json(x);
+    }
     out["particles"] = session->result.sampling.statistics.particles;
     out["exit"] = verdict.exit_code();
     out["converged"] = verdict.converged;
@@ -177,7 +187,9 @@ nlohmann::json run_case(const nlohmann::json& source, const nlohmann::json& size
     checks["symmetric_dirichlet"] =
         number(e, "symmetric_dirichlet") < number(x, "symmetric_dirichlet");
     bool pass = true;
-    for (const auto& [name, value] : checks.items()) pass = pass && value.get<bool>();
+    for (const auto& [name, value] : checks.items()) {
+      pass = pass && value.get<bool>();
+    }
     checks["pass"] = pass;
     out["checks"] = checks;
     out["pass"] = pass;
@@ -209,13 +221,17 @@ std::string decals_markdown(const nlohmann::json& report) {
     if (std::find(size_order.begin(), size_order.end(), size) == size_order.end()) {
       size_order.push_back(size);
     }
-    if (c.contains("error")) continue;
+    if (c.contains("error")) {
+      continue;
+    }
     length_margin[size].push_back(number(c["expmap"], "length_energy") /
                                   number(c["elastic"], "length_energy"));
     sd_margin[size].push_back(sd_excess(c["expmap"]) / sd_excess(c["elastic"]));
   }
   const auto median = [](std::vector<double> v) {
-    if (v.empty()) return std::numeric_limits<double>::quiet_NaN();
+    if (v.empty()) {
+      return std::numeric_limits<double>::quiet_NaN();
+    }
     std::sort(v.begin(), v.end());
     return v[v.size() / 2];
   };
@@ -258,7 +274,9 @@ std::string decals_markdown(const nlohmann::json& report) {
       return fmt(a, digits) + " (" + fmt(b, digits) + ")";
     };
     const auto shape = [&](const char* key) {
-      if (!e.contains("shape")) return std::string("–");
+      if (!e.contains("shape")) {
+        return std::string("–");
+      }
       return pair(number(e["shape"], key), number(x["shape"], key), 3);
     };
     s << c["particles"] << " | "
@@ -293,8 +311,12 @@ int run_decals(const DecalArgs& args, const CLI::App& sub) {
           const std::string name = source.at("name").get<std::string>() + " → " +
                                    target.at("name").get<std::string>() + " " +
                                    size.at("name").get<std::string>();
-          if (!args.only.empty() && name != args.only) continue;
-          if (!args.quiet) std::cerr << "elastic bench decals: " << name << '\n';
+          if (!args.only.empty() && name != args.only) {
+            continue;
+          }
+          if (!args.quiet) {
+            std::cerr << "elastic bench decals: " << name << '\n';
+          }
           report["cases"].push_back(run_case(source, size, target, particles, args, cache));
           const nlohmann::json& last = report["cases"].back();
           passed += last["pass"].get<bool>() ? 1 : 0;
@@ -345,7 +367,9 @@ BoundaryShape boundary_shape(const std::vector<double>& turns,
                              const std::vector<int>& corners) {
   BoundaryShape shape;
   const auto n = static_cast<int>(turns.size());
-  if (corners.empty() || n < 3 || source_turns.size() != turns.size()) return shape;
+  if (corners.empty() || n < 3 || source_turns.size() != turns.size()) {
+    return shape;
+  }
   const auto change = [&](int k) {
     const auto i = static_cast<size_t>(((k % n) + n) % n);
     return std::abs(turns[i] - source_turns[i]);
@@ -354,7 +378,9 @@ BoundaryShape boundary_shape(const std::vector<double>& turns,
   for (size_t c = 0; c < corners.size(); ++c) {
     const int first = corners[c];
     const int last = corners[(c + 1) % corners.size()] + (c + 1 == corners.size() ? n : 0);
-    for (int k = first + 1; k < last; ++k) sides += change(k);
+    for (int k = first + 1; k < last; ++k) {
+      sides += change(k);
+    }
     shape.corner_error_deg = std::max(shape.corner_error_deg, change(first));
   }
   shape.edge_turning_deg = sides / static_cast<double>(corners.size());

@@ -97,7 +97,9 @@ std::vector<MethodMeasurement> compare_methods(const MapSession& session,
     shared.low = first.low;
     shared.high = first.high;
     for (const MethodMeasurement& m : out) {
-      if (!m.ok) continue;
+      if (!m.ok) {
+        continue;
+      }
       write_mesh(options.heatmap_dir / (m.name + ".ply"),
                  make_heatmap(m.positions, m.metrics, shared).mesh);
     }
@@ -129,12 +131,16 @@ nlohmann::json measurement_json(const MethodMeasurement& m) {
   j["outside"] = x.outside;
   j["outside_triangles"] = x.outside_triangles;
   j["measured_triangles"] = x.measured_triangles;
-  for (const auto& [key, value] : m.extra.items()) j[key] = value;
+  for (const auto& [key, value] : m.extra.items()) {
+    j[key] = value;
+  }
   return j;
 }
 
 std::string method_status(const MethodMeasurement& m) {
-  if (!m.ok) return "failed";
+  if (!m.ok) {
+    return "failed";
+  }
   std::vector<std::string> problems;
   if (m.extra.contains("converged") && !m.extra["converged"].get<bool>()) {
     problems.push_back("not converged");
@@ -143,10 +149,16 @@ std::string method_status(const MethodMeasurement& m) {
     problems.push_back(std::to_string(m.metrics.folds) +
                        (m.metrics.folds == 1 ? " fold" : " folds"));
   }
-  if (m.metrics.outside > 0) problems.push_back(std::to_string(m.metrics.outside) + " outside");
-  if (problems.empty()) return "ok";
+  if (m.metrics.outside > 0) {
+    problems.push_back(std::to_string(m.metrics.outside) + " outside");
+  }
+  if (problems.empty()) {
+    return "ok";
+  }
   std::string out = "**";
-  for (size_t k = 0; k < problems.size(); ++k) out += (k > 0 ? ", " : "") + problems[k];
+  for (size_t k = 0; k < problems.size(); ++k) {
+    out += (k > 0 ? ", " : "") + problems[k];
+  }
   return out + "**";
 }
 

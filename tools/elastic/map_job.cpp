@@ -25,7 +25,9 @@ double seconds_since(std::chrono::steady_clock::time_point start) {
 
 /// A placed decal's placement (null for a drawn target region).
 nlohmann::json decal_report(const MapSession& session) {
-  if (!session.decal) return nullptr;
+  if (!session.decal) {
+    return nullptr;
+  }
   const DecalGeometry& g = *session.decal;
   const auto vec = [](const Eigen::Vector3d& v) { return nlohmann::json{v.x(), v.y(), v.z()}; };
   return {{"point", vec(g.placement.point)},
@@ -72,7 +74,9 @@ nlohmann::json subdivision_report(const MapResult& r) {
 // than ignored.
 void check_decal_flags(const MapJob& job) {
   const auto refuse = [](bool given, const std::string& flag, const std::string& why) {
-    if (given) throw UsageError(flag + " does not apply to --target-place: " + why);
+    if (given) {
+      throw UsageError(flag + " does not apply to --target-place: " + why);
+    }
   };
   refuse(job.rest_scale != "auto", "--rest-scale", "the decal's size is its SCALE");
   refuse(job.boundary != "auto", "--boundary", "a placed decal's boundary is free");
@@ -111,7 +115,9 @@ Eigen::Vector3d parse_point(const std::string& text, const std::string& flag) {
     throw UsageError(flag + ": expected X,Y,Z (finite numbers), got '" + text + "'");
   }
   std::string rest;
-  if (in >> rest) throw UsageError(flag + ": expected X,Y,Z (finite numbers), got '" + text + "'");
+  if (in >> rest) {
+    throw UsageError(flag + ": expected X,Y,Z (finite numbers), got '" + text + "'");
+  }
   return p;
 }
 
@@ -277,12 +283,18 @@ std::unique_ptr<MapSession> run_map_job(const MapJob& job, const ProgressCallbac
                                                                   : ImageRegionShape::Rectangle},
                          image_read_options(job));
   }
-  if (progress) progress({.stage = "load"});
+  if (progress) {
+    progress({.stage = "load"});
+  }
   // A surface from the cache, or loaded (and then cached).
   const auto surface = [&](const std::string& key, const auto& load) {
-    if (cache == nullptr) return load();
+    if (cache == nullptr) {
+      return load();
+    }
     const auto found = cache->find(key);
-    if (found != cache->end()) return found->second;
+    if (found != cache->end()) {
+      return found->second;
+    }
     return cache->emplace(key, load()).first->second;
   };
   s.source =
@@ -294,7 +306,9 @@ std::unique_ptr<MapSession> run_map_job(const MapJob& job, const ProgressCallbac
                     [&] { return load_surface(job.source, job.scheme); });
   print_warnings(s.source.warnings, job.quiet);
   s.target = surface(target_key, [&] {
-    if (!target_read) return load_surface(job.target, job.scheme);
+    if (!target_read) {
+      return load_surface(job.target, job.scheme);
+    }
     LoadedSurface loaded = surface_from_mesh(std::move(target_read->mesh), job.target, job.scheme);
     loaded.warnings.insert(loaded.warnings.begin(), target_read->warnings.begin(),
                            target_read->warnings.end());
@@ -304,8 +318,9 @@ std::unique_ptr<MapSession> run_map_job(const MapJob& job, const ProgressCallbac
 
   RegionSpec source_spec =
       s.image ? s.image->region : parse_region_flag(job.source_region, "--source-region");
-  if (!job.source_anchor.empty())
+  if (!job.source_anchor.empty()) {
     source_spec.anchor = parse_point(job.source_anchor, "--source-anchor");
+  }
   s.source_region = make_region(*s.source.projector, source_spec, {.name = "--source-region"});
   MapOptions options = make_map_options(job, progress);
   options.relaxation.frame = frame;
@@ -315,8 +330,9 @@ std::unique_ptr<MapSession> run_map_job(const MapJob& job, const ProgressCallbac
     run_decal(job, options, s);
   } else {
     RegionSpec target_spec = parse_region_flag(job.target_region, "--target-region");
-    if (!job.target_anchor.empty())
+    if (!job.target_anchor.empty()) {
       target_spec.anchor = parse_point(job.target_anchor, "--target-anchor");
+    }
     s.target_region = make_region(*s.target.projector, target_spec, {.name = "--target-region"});
     s.seconds_loading = seconds_since(start);
     s.result = map_regions(*s.source.projector, s.source_region, *s.target.projector,
@@ -338,12 +354,16 @@ void check_particles(long particles) {
 std::string effective_source_region(const MapJob& job) {
   // An image source's region is its rectangle unless the ellipse is asked for; "boundary" (the
   // flag's default for a mesh) means the rectangle there.
-  if (!job.source_image.empty() && job.source_region != "ellipse") return "rectangle";
+  if (!job.source_image.empty() && job.source_region != "ellipse") {
+    return "rectangle";
+  }
   return job.source_region;
 }
 
 nlohmann::json recorded_job(const MapJob& job, nlohmann::json job_json) {
-  if (job_json.contains("source-region")) job_json["source-region"] = effective_source_region(job);
+  if (job_json.contains("source-region")) {
+    job_json["source-region"] = effective_source_region(job);
+  }
   return job_json;
 }
 
@@ -426,7 +446,9 @@ MapMetrics measure_placement(const MapSession& session, const Eigen::Matrix3Xd& 
 }
 
 void write_report(const std::string& path, const nlohmann::json& report) {
-  if (path.empty()) return;
+  if (path.empty()) {
+    return;
+  }
   write_file_atomically(path, [&](std::ofstream& out) { out << report.dump(2) << '\n'; });
 }
 

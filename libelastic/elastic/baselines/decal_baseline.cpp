@@ -16,7 +16,9 @@ DecalBaselineResult exponential_map_decal(const LimitSurface& target, const Deca
   DecalBaselineResult result;
   result.positions = placed.positions;
   result.points = placed.points;
-  for (const double r : reached) result.stopped += r < 1.0 ? 1 : 0;
+  for (const double r : reached) {
+    result.stopped += r < 1.0 ? 1 : 0;
+  }
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;
 }

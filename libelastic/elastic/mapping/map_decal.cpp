@@ -35,7 +35,9 @@ Eigen::Vector3d unit_normal(const SurfaceProjector& projector, const SurfacePoin
                             const Eigen::Vector3d& position) {
   const SurfaceDerivatives d = projector.surface().derivatives(p);
   const Eigen::Vector3d n = d.du.cross(d.dv);
-  if (n.norm() > 1e-300) return n.normalized();
+  if (n.norm() > 1e-300) {
+    return n.normalized();
+  }
   return projector.closest(position, p).normal;
 }
 
@@ -86,7 +88,9 @@ void source_frame(const Region& region, const ParticleGrid& grid, DecalGeometry&
     }
   }
   double sum = 0.0;
-  for (const Spring& s : grid.springs) sum += s.rest;
+  for (const Spring& s : grid.springs) {
+    sum += s.rest;
+  }
   const double spacing =
       grid.springs.empty() ? 0.0 : sum / static_cast<double>(grid.springs.size());
   const Eigen::Vector2d above =
@@ -137,7 +141,9 @@ double turn_degrees(const DecalGeometry& g, const Eigen::Matrix3Xd& start,
   double sum = 0.0, weight = 0.0;
   for (Eigen::Index p = 0; p < start.cols(); ++p) {
     const double r = g.source_coordinates[static_cast<size_t>(p)].norm();
-    if (p == pin || r < 0.25 * g.source_radius) continue;
+    if (p == pin || r < 0.25 * g.source_radius) {
+      continue;
+    }
     Eigen::Vector3d a = start.col(p) - start.col(pin), b = end.col(p) - end.col(pin);
     a -= normal * normal.dot(a);
     b -= normal * normal.dot(b);
@@ -152,7 +158,9 @@ void check_no_overlap(const ParticleGrid& grid, const InitialMap& placement,
                       const std::string& name) {
   const std::vector<int> overlapping =
       self_overlapping_particles(grid, placement.positions, unit_normals(target, placement));
-  if (overlapping.empty()) return;
+  if (overlapping.empty()) {
+    return;
+  }
   double inner = g.source_radius;
   for (const int p : overlapping) {
     inner = std::min(inner, g.source_coordinates[static_cast<size_t>(p)].norm());
@@ -173,18 +181,30 @@ std::unique_ptr<Region> cut_target_region(const SurfaceProjector& target, const 
   RegionSpec spec;
   spec.kind = RegionSpec::Kind::Points;
   spec.text = "the decal's relaxed boundary";
-  for (const int p : grid.boundary_loop) spec.points.emplace_back(relaxed.positions.col(p));
-  spec.anchor = spec.points.front();
-  std::unique_ptr<Region> region;
-  try {
-    region = std::make_unique<Region>(
-        make_region(target, spec, {.name = name, .euclidean_bands = true}));
-  } catch (const InvalidInputError& e) {
-    throw InvalidInputError(name, std::string("the decal's boundary does not bound a disk on the "
-                                              "target (") +
-                                      e.problem() + "); make it smaller");
+  for (const int p : grid.boundary_loop) {
+    spec.points.emplace_back(relaxed.positions.col(p));
   }
-  return region;
+  spec.anchor = spec.points.front();
+  // The cut has been seen to stop with an internal error on the polygon's closing side (rectangle
+  // -> vase half of the decal bench: "coincident curve points"; the same polygon started one point
+  // later cuts fine, to the same region). Until that is found in regions/, the polygon is tried
+  // again from its next points; the anchor stays the first particle.
+  constexpr int kStarts = 3;
+  for (int start = 0;; ++start) {
+    try {
+      return std::make_unique<Region>(
+          make_region(target, spec, {.name = name, .euclidean_bands = true}));
+    } catch (const InvalidInputError& e) {
+      throw InvalidInputError(name, std::string("the decal's boundary does not bound a disk on "
+                                                "the target (") +
+                                        e.problem() + "); make it smaller");
+    } catch (const NumericalError&) {
+      if (start + 1 == kStarts) {
+        throw;
+      }
+      std::rotate(spec.points.begin(), spec.points.begin() + 1, spec.points.end());
+    }
+  }
 }
 
 // The cut snaps curve points within 1e-3 of a tessellation triangle onto its edges and corners
@@ -202,7 +222,9 @@ double snap_into_region(const RegionDiskMap& disk, const Region& region, double 
   points = relaxed.points;
   Eigen::Vector2d z;
   for (size_t p = 0; p < relaxed.points.size(); ++p) {
-    if (disk.to_disk(relaxed.points[p], z)) continue;
+    if (disk.to_disk(relaxed.points[p], z)) {
+      continue;
+    }
     const Eigen::Vector3d x = relaxed.positions.col(static_cast<Eigen::Index>(p));
     int best = -1;
     double nearest = std::numeric_limits<double>::infinity();
@@ -258,16 +280,26 @@ DecalPlacement parse_decal_placement(const std::string& text, const std::string&
     } catch (const std::exception&) {
       throw bad();
     }
-    if (used != item.size() || !std::isfinite(value)) throw bad();
+    if (used != item.size() || !std::isfinite(value)) {
+      throw bad();
+    }
     values.push_back(value);
   }
   const auto commas = static_cast<size_t>(std::count(text.begin(), text.end(), ','));
-  if (values.size() < 3 || values.size() > 5 || commas + 1 != values.size()) throw bad();
+  if (values.size() < 3 || values.size() > 5 || commas + 1 != values.size()) {
+    throw bad();
+  }
   DecalPlacement placement;
   placement.point = {values[0], values[1], values[2]};
-  if (values.size() > 3) placement.angle_degrees = values[3];
-  if (values.size() > 4) placement.scale = values[4];
-  if (!(placement.scale > 0.0)) throw bad();
+  if (values.size() > 3) {
+    placement.angle_degrees = values[3];
+  }
+  if (values.size() > 4) {
+    placement.scale = values[4];
+  }
+  if (!(placement.scale > 0.0)) {
+    throw bad();
+  }
   return placement;
 }
 
@@ -287,10 +319,14 @@ InitialMap exponential_map_placement(const LimitSurface& target, const DecalGeom
       const GeodesicShot shot = exponential_map(target, g.target_centre, v, options);
       out.points[p] = shot.point;
       out.positions.col(static_cast<Eigen::Index>(p)) = shot.position;
-      if (shot.hit_boundary) fraction[p] = v.norm() > 0.0 ? shot.length / v.norm() : 1.0;
+      if (shot.hit_boundary) {
+        fraction[p] = v.norm() > 0.0 ? shot.length / v.norm() : 1.0;
+      }
     }
   });
-  if (reached != nullptr) *reached = std::move(fraction);
+  if (reached != nullptr) {
+    *reached = std::move(fraction);
+  }
   return out;
 }
 
@@ -303,7 +339,9 @@ std::vector<int> self_overlapping_particles(const ParticleGrid& grid,
   double longest = 0.0;
   for (const auto f : grid.mesh.faces()) {
     std::vector<int> corners;
-    for (const auto v : grid.mesh.fv_range(f)) corners.push_back(v.idx());
+    for (const auto v : grid.mesh.fv_range(f)) {
+      corners.push_back(v.idx());
+    }
     for (size_t k = 1; k + 1 < corners.size(); ++k) {
       triangles.emplace_back(corners[0], corners[k], corners[k + 1]);
     }
@@ -313,7 +351,9 @@ std::vector<int> self_overlapping_particles(const ParticleGrid& grid,
           (positions.col(corners[k]) - positions.col(corners[(k + 1) % corners.size()])).norm());
     }
   }
-  if (!(longest > 0.0)) return {};
+  if (!(longest > 0.0)) {
+    return {};
+  }
   const double cell = longest;
   const auto key = [&](const Eigen::Vector3d& x) {
     const Eigen::Vector3d c = (x / cell).array().floor();
@@ -345,18 +385,26 @@ std::vector<int> self_overlapping_particles(const ParticleGrid& grid,
     const auto [first, last] = cells.equal_range(key(x));
     for (auto it = first; it != last; ++it) {
       const Eigen::Vector3i& t = triangles[static_cast<size_t>(it->second)];
-      if (t[0] == p || t[1] == p || t[2] == p) continue;
+      if (t[0] == p || t[1] == p || t[2] == p) {
+        continue;
+      }
       const Eigen::Vector3d a = positions.col(t[0]), b = positions.col(t[1]),
                             c = positions.col(t[2]);
       Eigen::Vector3d n = (b - a).cross(c - a);
       const double twice = n.norm();
-      if (!(twice > 0.0)) continue;
+      if (!(twice > 0.0)) {
+        continue;
+      }
       n /= twice;
       // Same side of the surface, and close to the triangle's plane (a thin part's other side
       // faces away; a far sheet is far).
-      if (n.dot(normals.col(p)) < 0.5) continue;
+      if (n.dot(normals.col(p)) < 0.5) {
+        continue;
+      }
       const double edge = std::max({(b - a).norm(), (c - b).norm(), (a - c).norm()});
-      if (std::abs(n.dot(x - a)) > 0.5 * edge) continue;
+      if (std::abs(n.dot(x - a)) > 0.5 * edge) {
+        continue;
+      }
       // Strictly inside, by a margin: a fold-free neighbour's corner is outside.
       const double wa = n.dot((b - x).cross(c - x)) / twice;
       const double wb = n.dot((c - x).cross(a - x)) / twice;
@@ -404,11 +452,15 @@ MapDecalResult map_decal(const SurfaceProjector& source, const Region& source_re
   map.rest_scale = placement.scale;
   // The grid's mean spacing on the target.
   double sum = 0.0;
-  for (const Spring& s : grid.springs) sum += s.rest;
+  for (const Spring& s : grid.springs) {
+    sum += s.rest;
+  }
   const double spacing =
       grid.springs.empty() ? 0.0 : placement.scale * sum / static_cast<double>(grid.springs.size());
   ExponentialMapOptions shooting = options.shooting;
-  if (shooting.step <= 0.0) shooting.step = 0.5 * spacing;
+  if (shooting.step <= 0.0) {
+    shooting.step = 0.5 * spacing;
+  }
   std::vector<double> reached;
   map.naive = exponential_map_placement(target.surface(), g, shooting, &reached);
   const double reach = *std::min_element(reached.begin(), reached.end());

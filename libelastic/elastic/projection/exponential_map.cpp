@@ -30,10 +30,14 @@ Eigen::Vector3d unit_normal(const LimitSurface& surface, const SurfacePoint& p) 
 double arc_length(const Eigen::Vector3d& chord, const Eigen::Vector3d& normal_x,
                   const Eigen::Vector3d& normal_y) {
   const double c = chord.norm();
-  if (c == 0.0) return 0.0;
+  if (c == 0.0) {
+    return 0.0;
+  }
   const double half_angle =
       std::min(1.0, 0.5 * std::abs((normal_y - normal_x).dot(chord)) / c);  // kappa c / 2
-  if (half_angle < 1e-8) return c;
+  if (half_angle < 1e-8) {
+    return c;
+  }
   return c * std::asin(half_angle) / half_angle;
 }
 
@@ -50,7 +54,9 @@ struct Step {
 Eigen::Vector3d second_order_goal(const SurfaceDerivatives& d, const Eigen::Vector3d& normal,
                                   const Eigen::Vector3d& t, double h) {
   Eigen::Vector2d ab;
-  if (!pull_back(d.du, d.dv, t, ab)) return d.position + h * t;
+  if (!pull_back(d.du, d.dv, t, ab)) {
+    return d.position + h * t;
+  }
   const Eigen::Vector3d d2 =
       ab.x() * ab.x() * d.duu + 2.0 * ab.x() * ab.y() * d.duv + ab.y() * ab.y() * d.dvv;
   const double k = -d2.dot(normal) / (ab.x() * d.du + ab.y() * d.dv).squaredNorm();
@@ -168,14 +174,18 @@ GeodesicShot exponential_map(const LimitSurface& surface, const SurfacePoint& fr
     const Eigen::Vector3d n = step.foot.normal;
     Eigen::Vector3d next = Eigen::Quaterniond::FromTwoVectors(normal, n) * t;
     next -= n * n.dot(next);
-    if (next.norm() > 0.0) t = next.normalized();
+    if (next.norm() > 0.0) {
+      t = next.normalized();
+    }
     normal = n;
     walked += last ? remaining : step.arc;
     h = std::min(longest, 2.0 * h);  // back up after a halving
     p = step.foot.point;
     x = step.position;
     here = step.foot.d;
-    if (last) break;
+    if (last) {
+      break;
+    }
   }
   shot.point = p;
   shot.position = x;

@@ -424,7 +424,9 @@ class SideBands {
   SideBands(const Context& ctx, const std::vector<MeshLocation>& locs,
             const std::vector<Eigen::Vector3d>& where)
       : ctx_(ctx), locs_(locs), where_(where) {
-    if (ctx.options.euclidean_bands) index_vertices();
+    if (ctx.options.euclidean_bands) {
+      index_vertices();
+    }
   }
 
   std::vector<char> heat(size_t i, size_t j) {
@@ -434,7 +436,9 @@ class SideBands {
       dist_.resize(locs_.size());
     }
     for (const size_t k : {i, j}) {
-      if (dist_[k].size() == 0) dist_[k] = heat_->distance(locs_[k]);
+      if (dist_[k].size() == 0) {
+        dist_[k] = heat_->distance(locs_[k]);
+      }
     }
     return regions_detail::geodesic_band(ctx_.tess.triangles, dist_[i], dist_[j], 0.5,
                                          4.0 * heat_->mean_edge_length());
@@ -452,10 +456,14 @@ class SideBands {
       for (int dy = -1; dy <= 1; ++dy) {
         for (int dz = -1; dz <= 1; ++dz) {
           const auto found = cells_.find(key(c + Eigen::Vector3i(dx, dy, dz)));
-          if (found == cells_.end()) continue;
+          if (found == cells_.end()) {
+            continue;
+          }
           for (const int v : found->second) {
             const Eigen::Vector3d& x = ctx_.tess.positions[static_cast<size_t>(v)];
-            if ((x - a).norm() + (x - b).norm() > bound) continue;
+            if ((x - a).norm() + (x - b).norm() > bound) {
+              continue;
+            }
             for (const int t : vertex_triangles_[static_cast<size_t>(v)]) {
               band[static_cast<size_t>(t)] = 1;
             }
@@ -498,7 +506,9 @@ class SideBands {
     for (size_t i = 0; i < where_.size(); ++i) {
       cell_size_ = std::max(cell_size_, bound(i, (i + 1) % where_.size()));
     }
-    if (!(cell_size_ > 0.0)) cell_size_ = 1.0;
+    if (!(cell_size_ > 0.0)) {
+      cell_size_ = 1.0;
+    }
     for (size_t v = 0; v < x.size(); ++v) {
       cells_[key(cell(x[v]))].push_back(static_cast<int>(v));
     }
@@ -561,7 +571,9 @@ Region points_region(const Context& ctx, const RegionSpec& spec) {
         path.clear();
       }
     }
-    if (path.empty()) path = geodesics.path(locs[i], locs[j], bands.heat(i, j));
+    if (path.empty()) {
+      path = geodesics.path(locs[i], locs[j], bands.heat(i, j));
+    }
     for (const auto& node : path) {
       // Express the node in the triangle that holds the segment leaving it.
       MeshLocation m{node.segment_triangle, Eigen::Vector3d::Zero()};

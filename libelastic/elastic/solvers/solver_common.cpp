@@ -103,7 +103,9 @@ void choose_free_particles(const RelaxationProblem& problem, const RelaxationOpt
       throw InvalidInputError(kName, "a free boundary needs at least one pinned particle");
     }
     for (std::size_t p = 0; p < P; ++p) {
-      if (pinned[p] == 0) make_free(p);
+      if (pinned[p] == 0) {
+        make_free(p);
+      }
     }
     setup.sliding.assign(setup.interior.size(), -1);
     setup.free_boundary = true;
