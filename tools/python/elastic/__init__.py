@@ -21,6 +21,12 @@ Example::
                             particles=2000)
     print(m.ok, m.metrics()["symmetric_dirichlet"])
 
+A decal placed by a point, an angle and a size (a free boundary, docs/transfer.md)::
+
+    d = elastic.place_decal(plane.region("disk:0.5,0.5,0,0.3"), cap, (0.28, 0.28, 0.92),
+                            angle=25, scale=1.5, particles=2000)
+    print(d.ok, d.decal["target_area"])
+
 Batches of jobs on a Dask cluster: ``python3 -m elastic.batch JOBS...`` (elastic.batch).
 """
 
@@ -36,6 +42,7 @@ from ._elastic import (  # noqa: F401  (re-exported)
     image_source,
     load_mesh,
     map_regions,
+    place_decal,
     save_mesh,
 )
 

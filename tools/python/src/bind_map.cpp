@@ -358,7 +358,113 @@ py::dict metrics_dict(const MapMetrics& m) {
   return out;
 }
 
+// place_decal: map_decal with the keywords of `elastic map --target-place` (tools/elastic).
+std::shared_ptr<MapState> run_decal(const std::shared_ptr<RegionState>& source_region,
+                                    const std::shared_ptr<SurfaceState>& target,
+                                    const DecalPlacement& placement, const MapKeywords& keywords,
+                                    const py::object& progress) {
+  if (keywords.subdivide != 0 || keywords.boundary != "auto" || keywords.rest_scale != "auto") {
+    throw py::value_error("place_decal: a placed decal's boundary is free and its size is its scale");
+  }
+  const MapOptions options = map_options(keywords);
+  MapDecalOptions decal;
+  decal.sampling = options.sampling;
+  decal.relaxation = options.relaxation;
+  decal.name = "place_decal";
+  PythonProgress listener(progress);
+  decal.progress = listener.callback();
+  decal.relaxation.progress = decal.progress;
+  auto state = std::make_shared<MapState>();
+  state->source = source_region->surface;
+  state->target = target;
+  state->source_region = source_region;
+  std::exception_ptr failure;
+  {
+    const py::gil_scoped_release release;
+    tbb::task_arena arena(keywords.threads > 0 ? keywords.threads : tbb::task_arena::automatic);
+    try {
+      arena.execute([&] {
+        MapDecalResult placed = map_decal(*state->source->projector, source_region->region,
+                                          *target->projector, placement, decal);
+        state->result = std::move(placed.map);
+        state->decal = std::move(placed.geometry);
+        state->placed_region = std::move(placed.target_region);
+        state->metrics = measure_on_target(*state, state->result.relaxation.positions,
+                                           state->result.relaxation.points);
+        state->naive_metrics =
+            measure_on_target(*state, state->result.naive.positions, state->result.naive.points);
+      });
+    } catch (...) {
+      failure = std::current_exception();
+    }
+  }
+  listener.rethrow();
+  if (failure) {
+    std::rethrow_exception(failure);
+  }
+  auto region = std::make_shared<RegionState>();
+  region->surface = target;
+  region->region = *state->placed_region;
+  state->target_region = std::move(region);
+  return state;
+}
+
+py::object decal_dict(const MapState& s) {
+  if (!s.decal) {
+    return py::none();
+  }
+  const DecalGeometry& g = *s.decal;
+  const auto vec = [](const Eigen::Vector3d& v) { return py::make_tuple(v.x(), v.y(), v.z()); };
+  py::dict d;
+  d["point"] = vec(g.placement.point);
+  d["angle_deg"] = g.placement.angle_degrees;
+  d["scale"] = g.placement.scale;
+  d["centre"] = vec(g.target_centre_position);
+  d["up"] = vec(g.target_frame.up);
+  d["normal"] = vec(g.target_frame.normal);
+  d["source_centre"] = vec(g.source_centre);
+  d["source_radius"] = g.source_radius;
+  d["turned_deg"] = g.turned_degrees;
+  d["target_area"] = s.placed_region ? s.placed_region->area() : 0.0;
+  return d;
+}
+
 void bind_map(py::module_& m) {
+  m.def(
+      "place_decal",
+      [](const std::shared_ptr<RegionState>& source_region,
+         const std::shared_ptr<SurfaceState>& target, const std::array<double, 3>& point,
+         double angle, double scale, long particles, const std::string& solver,
+         const std::string& energy, int threads, double jitter, unsigned long seed,
+         long max_iterations, double curvature_radius, const py::object& progress) {
+        const DecalPlacement placement{.point = {point[0], point[1], point[2]},
+                                       .angle_degrees = angle,
+                                       .scale = scale};
+        MapKeywords k;
+        k.angular_stiffness = py::none();  // the energy's default
+        k.particles = particles;
+        k.solver = solver;
+        k.energy = energy;
+        k.threads = threads;
+        k.jitter = jitter;
+        k.seed = seed;
+        k.max_iterations = max_iterations;
+        k.curvature_radius = curvature_radius;
+        return run_decal(source_region, target, placement, k, progress);
+      },
+      py::arg("source_region"), py::arg("target"), py::arg("point"), py::kw_only(),
+      py::arg("angle") = 0.0, py::arg("scale") = 1.0, py::arg("particles") = 1000,
+      py::arg("solver") = "lbfgs", py::arg("energy") = "robust", py::arg("threads") = 0,
+      py::arg("jitter") = 0.0, py::arg("seed") = 0, py::arg("max_iterations") = 0,
+      py::arg("curvature_radius") = AdaptiveSamplingOptions{}.curvature_radius,
+      py::arg("progress") = py::none(),
+      "Places source_region on the target Surface as a decal with a free boundary, as `elastic "
+      "map --target-place X,Y,Z,ANGLE,SCALE` (docs/transfer.md): its centre at the target point "
+      "closest to `point`, its up `angle` degrees counter-clockwise from the world +Y projected "
+      "on the surface, `scale` times its own size. -> Map (Map.decal says where it went; paste() "
+      "paints the region cut along its relaxed boundary). A decal that runs off the "
+      "surface or overlaps itself raises ValueError saying how much smaller it must be.");
+
   m.def(
       "map_regions",
       [](const std::shared_ptr<RegionState>& source_region,
@@ -397,6 +503,10 @@ void bind_map(py::module_& m) {
           "ok",
           [](const MapState& s) { return s.result.relaxation.converged && s.metrics.folds == 0; },
           "The verdict of `elastic map`: converged and fold-free.")
+      .def_property_readonly("decal", &decal_dict,
+                             "A placed decal's placement (place_decal; None for map_regions): "
+                             "point, angle_deg, scale, centre, up, normal, source_centre, "
+                             "source_radius, turned_deg, target_area, as the report's 'decal'.")
       .def_property_readonly(
           "converged", [](const MapState& s) { return s.result.relaxation.converged; },
           "Whether the solver's stop is a convergence (the report's 'converged').")

@@ -13,6 +13,7 @@
 #include <string>
 
 #include "elastic/core/progress.h"
+#include "elastic/mapping/map_decal.h"
 #include "elastic/mapping/map_regions.h"
 #include "elastic/mesh/polygon_mesh.h"
 #include "elastic/metrics/map_metrics.h"
@@ -42,6 +43,10 @@ struct MapState {
   std::shared_ptr<const RegionState> source_region, target_region;
   MapResult result;
   MapMetrics metrics, naive_metrics;  // docs/metrics.md, as `elastic map` reports them
+  /// A placed decal (place_decal): its placement, and the region cut along its relaxed boundary
+  /// that the Mapping references (target_region holds a copy for the transfer).
+  std::optional<DecalGeometry> decal;
+  std::unique_ptr<Region> placed_region;
   /// The map's differential per grid triangle, built on first use (transport_vectors).
   std::once_flag differential_once;
   std::unique_ptr<MapDifferential> differential;

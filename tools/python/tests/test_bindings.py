@@ -309,3 +309,37 @@ def test_a_mesh_of_mixed_polygons_from_a_list(tmp_path):
         elastic.Mesh(vertices, [[0, 1, 2], [1, 2]])
     with pytest.raises(ValueError, match="faces"):
         elastic.Mesh(vertices, "0 1 2")
+
+
+def test_place_decal_matches_the_tools_report_and_pastes(plane, cap, tmp_path):
+    job = {
+        "source": str(MESHES / "grid.off"),
+        "source-region": "disk:0.5,0.5,0,0.3",
+        "target": str(MESHES / "hemisphere.off"),
+        "target-place": "0.275924,0.275924,0.91974,25,1.5",
+        "particles": 600,
+    }
+    report = tool_report("map", job, tmp_path)
+    m = elastic.place_decal(
+        plane.region("disk:0.5,0.5,0,0.3"), cap, (0.275924, 0.275924, 0.91974),
+        angle=25, scale=1.5, particles=600, threads=2,
+    )
+    assert m.ok and m.folds == report["folds"] == 0
+    assert m.num_particles == report["particles"]
+    assert m.iterations == report["iterations"]
+    assert m.energy["length"] == pytest.approx(report["energy"]["length"], rel=1e-12)
+    assert m.rest_scale == pytest.approx(1.5, rel=1e-15)
+    d = m.decal
+    assert d["scale"] == 1.5 and d["angle_deg"] == 25
+    assert d["centre"] == pytest.approx(report["decal"]["centre"], rel=1e-12)
+    assert d["target_area"] == pytest.approx(report["decal"]["target_area"], rel=1e-12)
+    assert elastic.map_regions(plane.region("disk:0.5,0.5,0,0.3"), cap.region("boundary"),
+                               particles=100).decal is None
+    _, logo = elastic.image_source(str(MESHES / "pmp_logo_512.png"), width=0.5)
+    d = elastic.place_decal(logo, cap, (0.275924, 0.275924, 0.91974), angle=-10, particles=400)
+    assert d.ok and d.decal["target_area"] == pytest.approx(0.25, rel=0.02)
+    files = d.paste(str(tmp_path / "decal"))
+    assert "painted.obj" in {os.path.basename(f) for f in files}
+    with pytest.raises(ValueError, match="SCALE at most"):
+        elastic.place_decal(plane.region("disk:0.5,0.5,0,0.3"), cap, (0.9, 0.0, 0.3), scale=3,
+                            particles=200)
