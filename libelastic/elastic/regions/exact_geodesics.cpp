@@ -57,16 +57,25 @@ struct ExactGeodesics::Impl {
     }
   }
 
-  void build(const std::vector<char>& band) {
+  // The band's triangles in increasing order. The inverse maps are reset where the last band set
+  // them, not over the whole tessellation: a decal's boundary on a million-triangle head has
+  // hundreds of small bands.
+  void build(const std::vector<int>& band) {
+    if (face_of.size() != tri.size()) {
+      face_of.assign(tri.size(), -1);
+      vertex_of.assign(x.size(), -1);
+    }
+    for (const int t : faces) {
+      face_of[static_cast<size_t>(t)] = -1;
+    }
+    for (const int v : vertices) {
+      vertex_of[static_cast<size_t>(v)] = -1;
+    }
     mesh.clear();
     faces.clear();
     vertices.clear();
-    face_of.assign(tri.size(), -1);
-    vertex_of.assign(x.size(), -1);
-    for (size_t t = 0; t < tri.size(); ++t) {
-      if (!band[t]) {
-        continue;
-      }
+    for (const int band_triangle : band) {
+      const auto t = static_cast<size_t>(band_triangle);
       std::array<VertexIndex, 3> v;
       for (int k = 0; k < 3; ++k) {
         const size_t g = static_cast<size_t>(tri[t][k]);
@@ -210,12 +219,26 @@ std::vector<char> geodesic_band(const std::vector<Eigen::Vector3i>& triangles,
 
 std::vector<PathNode> ExactGeodesics::path(const MeshLocation& from, const MeshLocation& to,
                                            const std::vector<char>& band) {
+  if (band.size() != impl_->tri.size()) {
+    throw NumericalError(impl_->name, "internal: the geodesic band is not one flag per triangle");
+  }
+  std::vector<int> list;
+  for (size_t t = 0; t < band.size(); ++t) {
+    if (band[t]) {
+      list.push_back(static_cast<int>(t));
+    }
+  }
+  return path(from, to, list);
+}
+
+std::vector<PathNode> ExactGeodesics::path(const MeshLocation& from, const MeshLocation& to,
+                                           const std::vector<int>& band) {
   Impl& m = *impl_;
-  if (band.size() != m.tri.size() || !band[static_cast<size_t>(from.triangle)] ||
-      !band[static_cast<size_t>(to.triangle)]) {
+  m.build(band);
+  if (m.face_of[static_cast<size_t>(from.triangle)] < 0 ||
+      m.face_of[static_cast<size_t>(to.triangle)] < 0) {
     throw NumericalError(m.name, "internal: the geodesic band misses a curve point");
   }
-  m.build(band);
   ShortestPath smsp(m.mesh);
   const auto face = [&](const MeshLocation& p) {
     return FaceIndex(static_cast<Mesh::size_type>(m.face_of[static_cast<size_t>(p.triangle)]));

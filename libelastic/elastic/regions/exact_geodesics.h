@@ -54,6 +54,10 @@ class ExactGeodesics {
   /// inside it.
   std::vector<PathNode> path(const MeshLocation& from, const MeshLocation& to,
                              const std::vector<char>& band);
+  /// The same with the band as its triangles' indices in increasing order (a small band of a large
+  /// tessellation costs its own size, not the tessellation's).
+  std::vector<PathNode> path(const MeshLocation& from, const MeshLocation& to,
+                             const std::vector<int>& band);
 
  private:
   struct Impl;

@@ -445,12 +445,13 @@ class SideBands {
   }
 
   /// The triangles with a corner v whose distances to the two ends add up to at most the bound
-  /// (geodesic_band's rule with 3D distances), found among the vertices near the first end.
-  std::vector<char> euclidean(size_t i, size_t j) const {
+  /// (geodesic_band's rule with 3D distances), found among the vertices near the first end, in
+  /// increasing order.
+  std::vector<int> euclidean(size_t i, size_t j) {
     const Eigen::Vector3d& a = where_[i];
     const Eigen::Vector3d& b = where_[j];
     const double bound = this->bound(i, j);
-    std::vector<char> band(ctx_.tess.triangles.size(), 0);
+    std::vector<int> band;
     const Eigen::Vector3i c = cell(a);
     for (int dx = -1; dx <= 1; ++dx) {
       for (int dy = -1; dy <= 1; ++dy) {
@@ -465,12 +466,14 @@ class SideBands {
               continue;
             }
             for (const int t : vertex_triangles_[static_cast<size_t>(v)]) {
-              band[static_cast<size_t>(t)] = 1;
+              band.push_back(t);
             }
           }
         }
       }
     }
+    std::sort(band.begin(), band.end());
+    band.erase(std::unique(band.begin(), band.end()), band.end());
     return band;
   }
 
