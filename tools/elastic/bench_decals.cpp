@@ -28,30 +28,9 @@ namespace {
 
 namespace fs = std::filesystem;
 
-struct DecalArgs {
-  std::string cases = std::string(ELASTIC_SOURCE_DIR) + "/tools/benchmarks/decal_cases.json";
-  std::string root = ELASTIC_SOURCE_DIR;
-  std::string report;
-  std::string markdown;
-  std::string only;
-  long particles = 0;
-  int threads = 0;
-  bool quiet = false;
+struct DecalArgs : BenchCaseArgs {
+  long particles = 0;  ///< --particles: every case's count (0: the cases file's)
 };
-
-std::string fmt(double v, int digits = 3) {
-  if (!std::isfinite(v)) {
-    return std::isnan(v) ? "–" : (v > 0 ? "inf" : "-inf");
-  }
-  std::ostringstream o;
-  o << std::setprecision(digits) << v;
-  return o.str();
-}
-
-double number(const nlohmann::json& j, const char* key) {
-  return j.contains(key) && j[key].is_number() ? j[key].get<double>()
-                                               : std::numeric_limits<double>::quiet_NaN();
-}
 
 // Unit normal du x dv of the target at a particle.
 Eigen::Vector3d normal_at(const LimitSurface& surface, const SurfacePoint& p) {
@@ -132,21 +111,15 @@ nlohmann::json run_case(const nlohmann::json& source, const nlohmann::json& size
     job.source_image = path(source["source_image"].get<std::string>());
     job.image_width = source.value("image_width", job.image_width);
   }
-  std::string region = source.value("source_region", "boundary");
-  if (region.rfind("points:", 0) == 0) {
-    region = "points:" + path(region.substr(7));
-  }
-  job.source_region = region;
+  job.source_region = rooted_spec(source.value("source_region", "boundary"), args.root);
   job.target = path(target.at("target").get<std::string>());
   job.target_place = place.str();
   job.particles = particles;
   job.threads = args.threads;
   job.quiet = true;
-  for (const std::string& p : {job.source, job.source_image, job.target}) {
-    if (!p.empty() && !fs::exists(p)) {
-      out["error"] = p + " is not present";
-      return out;
-    }
+  if (const std::string missing = missing_input(job); !missing.empty()) {
+    out["error"] = missing + " is not present";
+    return out;
   }
   try {
     const std::unique_ptr<MapSession> session = run_map_job(job, {}, {}, 1, &cache);
@@ -182,10 +155,10 @@ nlohmann::json run_case(const nlohmann::json& source, const nlohmann::json& size
     const nlohmann::json& x = out["expmap"];
     nlohmann::json checks;
     checks["exit_0"] = verdict.exit_code() == 0;
-    checks["fold_free"] = number(e, "folds") == 0.0;
-    checks["length_energy"] = number(e, "length_energy") < number(x, "length_energy");
+    checks["fold_free"] = json_number(e, "folds") == 0.0;
+    checks["length_energy"] = json_number(e, "length_energy") < json_number(x, "length_energy");
     checks["symmetric_dirichlet"] =
-        number(e, "symmetric_dirichlet") < number(x, "symmetric_dirichlet");
+        json_number(e, "symmetric_dirichlet") < json_number(x, "symmetric_dirichlet");
     bool pass = true;
     for (const auto& [name, value] : checks.items()) {
       pass = pass && value.get<bool>();
@@ -205,7 +178,7 @@ std::string bold_unless(bool ok, const std::string& text) {
 
 // Symmetric Dirichlet minus its isometric value 4: the part that is distortion.
 double sd_excess(const nlohmann::json& j) {
-  return number(j, "symmetric_dirichlet") - 4.0;
+  return json_number(j, "symmetric_dirichlet") - 4.0;
 }
 
 std::string decals_markdown(const nlohmann::json& report) {
@@ -224,8 +197,8 @@ std::string decals_markdown(const nlohmann::json& report) {
     if (c.contains("error")) {
       continue;
     }
-    length_margin[size].push_back(number(c["expmap"], "length_energy") /
-                                  number(c["elastic"], "length_energy"));
+    length_margin[size].push_back(json_number(c["expmap"], "length_energy") /
+                                  json_number(c["elastic"], "length_energy"));
     sd_margin[size].push_back(sd_excess(c["expmap"]) / sd_excess(c["elastic"]));
   }
   const auto median = [](std::vector<double> v) {
@@ -254,8 +227,9 @@ std::string decals_markdown(const nlohmann::json& report) {
     << "over the cases of each size, exponential map ÷ ElasticPaint): ";
   for (size_t k = 0; k < size_order.size(); ++k) {
     const std::string& size = size_order[k];
-    s << (k > 0 ? "; " : "") << size << ": length energy " << fmt(median(length_margin[size]))
-      << "×, SD − 4 " << fmt(median(sd_margin[size])) << "×";
+    s << (k > 0 ? "; " : "") << size << ": length energy "
+      << fmt_number(median(length_margin[size])) << "×, SD − 4 "
+      << fmt_number(median(sd_margin[size])) << "×";
   }
   s << ".\n\n";
   s << "| case | particles | exit | folds | length energy | SD − 4 | angle err mean (deg) | "
@@ -271,25 +245,27 @@ std::string decals_markdown(const nlohmann::json& report) {
     const nlohmann::json& x = c["expmap"];
     const nlohmann::json& k = c["checks"];
     const auto pair = [](double a, double b, int digits) {
-      return fmt(a, digits) + " (" + fmt(b, digits) + ")";
+      return fmt_number(a, digits) + " (" + fmt_number(b, digits) + ")";
     };
     const auto shape = [&](const char* key) {
       if (!e.contains("shape")) {
         return std::string("–");
       }
-      return pair(number(e["shape"], key), number(x["shape"], key), 3);
+      return pair(json_number(e["shape"], key), json_number(x["shape"], key), 3);
     };
     s << c["particles"] << " | "
       << bold_unless(k["exit_0"].get<bool>(), std::to_string(c["exit"].get<int>())) << " | "
-      << bold_unless(k["fold_free"].get<bool>(), pair(number(e, "folds"), number(x, "folds"), 4))
+      << bold_unless(k["fold_free"].get<bool>(),
+                     pair(json_number(e, "folds"), json_number(x, "folds"), 4))
       << " | "
       << bold_unless(k["length_energy"].get<bool>(),
-                     pair(number(e, "length_energy"), number(x, "length_energy"), 3))
+                     pair(json_number(e, "length_energy"), json_number(x, "length_energy"), 3))
       << " | "
       << bold_unless(k["symmetric_dirichlet"].get<bool>(), pair(sd_excess(e), sd_excess(x), 3))
-      << " | " << pair(number(e, "angle_error_mean_deg"), number(x, "angle_error_mean_deg"), 3)
+      << " | "
+      << pair(json_number(e, "angle_error_mean_deg"), json_number(x, "angle_error_mean_deg"), 3)
       << " | " << shape("edge_turning_deg") << " | " << shape("corner_error_deg") << " | "
-      << pair(number(e, "seconds"), number(x, "seconds"), 2) << " | "
+      << pair(json_number(e, "seconds"), json_number(x, "seconds"), 2) << " | "
       << (c["pass"].get<bool>() ? "pass" : "**fail**") << " |\n";
   }
   return s.str();
@@ -334,12 +310,7 @@ int run_decals(const DecalArgs& args, const CLI::App& sub) {
     throw InvalidInputError(args.cases, std::string("bad cases file: ") + e.what());
   }
   report["summary"] = {{"cases", report["cases"].size()}, {"passed", passed}};
-  write_report(args.report, report);
-  const std::string page = decals_markdown(report);
-  if (!args.markdown.empty()) {
-    write_file_atomically(args.markdown, [&](std::ofstream& out) { out << page; });
-  }
-  std::cout << page;
+  write_bench_outputs(args, report, decals_markdown(report));
   return kOk;
 }
 
@@ -391,18 +362,9 @@ std::function<int()> add_decals_subcommand(CLI::App& bench) {
   auto a = std::make_shared<DecalArgs>();
   CLI::App* sub = bench.add_subcommand(
       "decals", "Placed decals (--target-place) against the exponential-map decal, pass/fail");
-  sub->add_option("--cases", a->cases,
-                  "Cases file (JSON; default tools/benchmarks/decal_cases.json)");
-  sub->add_option("--root", a->root, "Folder the cases' paths are relative to");
-  sub->add_option("--report", a->report, "Write the JSON report here");
-  sub->add_option("--markdown", a->markdown, "Also write the Markdown table here");
+  add_bench_case_options(*sub, *a, "decal_cases.json");
   sub->add_option("--particles", a->particles, "Particles of every case (0: the cases file's)")
       ->check(CLI::Range(0L, kMaxParticles));
-  sub->add_option("--threads", a->threads, "Threads of every stage (0: all)")
-      ->check(CLI::Range(0, 1024));
-  sub->add_option("--only", a->only,
-                  "Run only the case with this name, e.g. 'rectangle → spot half'");
-  sub->add_flag("--quiet,-q", a->quiet, "No progress lines on stderr");
   sub->footer(
       "Example:\n  elastic bench decals --report decals.json --markdown decals.md\n"
       "Prints the table on stdout; exits 0 when every case ran (passing or not).");

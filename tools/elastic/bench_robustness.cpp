@@ -27,29 +27,9 @@ namespace {
 
 namespace fs = std::filesystem;
 
-struct RobustnessArgs {
-  std::string cases = std::string(ELASTIC_SOURCE_DIR) + "/tools/benchmarks/robustness_cases.json";
-  std::string root = ELASTIC_SOURCE_DIR;
-  std::string report;
-  std::string markdown;
-  std::string only;
-  int threads = 0;
-  bool quiet = false;
-};
+struct RobustnessArgs : BenchCaseArgs {};
 
 const std::vector<std::string> kBaselines = {"lscm", "arap", "dcm"};
-
-std::string fmt(double v, int digits = 3) {
-  if (!std::isfinite(v)) return std::isnan(v) ? "–" : (v > 0 ? "inf" : "-inf");
-  std::ostringstream o;
-  o << std::setprecision(digits) << v;
-  return o.str();
-}
-
-double number(const nlohmann::json& j, const char* key) {
-  return j.contains(key) && j[key].is_number() ? j[key].get<double>()
-                                               : std::numeric_limits<double>::quiet_NaN();
-}
 
 // The best baseline's figure of each metric (smallest SD, length energy and folds; largest
 // sigma_min) and which baseline it is. Only baselines that produced a valid map (ran, no folds, no
@@ -58,20 +38,28 @@ double number(const nlohmann::json& j, const char* key) {
 nlohmann::json best_baseline(const nlohmann::json& methods) {
   std::vector<std::string> ran, valid;
   for (const std::string& name : kBaselines) {
-    if (!methods.contains(name) || methods[name].contains("error")) continue;
+    if (!methods.contains(name) || methods[name].contains("error")) {
+      continue;
+    }
     ran.push_back(name);
     const nlohmann::json& m = methods[name];
-    if (m.value("folds", 1) == 0 && m.value("outside", 1) == 0) valid.push_back(name);
+    if (m.value("folds", 1) == 0 && m.value("outside", 1) == 0) {
+      valid.push_back(name);
+    }
   }
-  if (ran.empty()) return nullptr;
+  if (ran.empty()) {
+    return nullptr;
+  }
   const std::vector<std::string>& pool = valid.empty() ? ran : valid;
   nlohmann::json best = {{"valid", !valid.empty()}};
   const auto pick = [&](const char* key, bool larger, const std::vector<std::string>& from) {
     double value = larger ? -INFINITY : INFINITY;
     std::string who;
     for (const std::string& name : from) {
-      const double v = number(methods[name], key);
-      if (std::isnan(v)) continue;
+      const double v = json_number(methods[name], key);
+      if (std::isnan(v)) {
+        continue;
+      }
       if (larger ? v > value : v < value) {
         value = v;
         who = name;
@@ -93,27 +81,15 @@ void area_ratios(const MapSession& s, double& raw, double& scaled) {
   const TriangleValues& t = s.naive_metrics.per_triangle;
   double at = 0.0, as = 0.0;
   for (size_t k = 0; k < t.target_area.size(); ++k) {
-    if (t.excluded[k] || !std::isfinite(t.target_area[k])) continue;
+    if (t.excluded[k] || !std::isfinite(t.target_area[k])) {
+      continue;
+    }
     at += t.target_area[k];
     as += t.source_area[k];
   }
   raw = as > 0.0 ? at / as : std::numeric_limits<double>::quiet_NaN();
   const double sigma = s.result.rest_scale;
   scaled = raw / (sigma * sigma);
-}
-
-// A region spec whose file (points:FILE, uv:FILE) is relative, made relative to the root like the
-// cases' mesh paths; other specs as they are.
-std::string rooted_spec(const std::string& spec, const std::string& root) {
-  for (const std::string kind : {"points:", "uv:"}) {
-    if (spec.rfind(kind, 0) != 0) continue;
-    const size_t end = spec.find(';');
-    const std::string file = spec.substr(kind.size(), end - kind.size());
-    if (fs::path(file).is_absolute()) return spec;
-    return kind + (fs::path(root) / file).string() +
-           (end == std::string::npos ? std::string() : spec.substr(end));
-  }
-  return spec;
 }
 
 nlohmann::json run_case(const nlohmann::json& c, const RobustnessArgs& args, SurfaceCache& cache) {
@@ -129,8 +105,12 @@ nlohmann::json run_case(const nlohmann::json& c, const RobustnessArgs& args, Sur
   // The defaults a user gets: only what the case names is set.
   MapJob job;
   const auto path = [&](const std::string& p) { return (fs::path(args.root) / p).string(); };
-  if (c.contains("source")) job.source = path(c["source"].get<std::string>());
-  if (c.contains("source_image")) job.source_image = path(c["source_image"].get<std::string>());
+  if (c.contains("source")) {
+    job.source = path(c["source"].get<std::string>());
+  }
+  if (c.contains("source_image")) {
+    job.source_image = path(c["source_image"].get<std::string>());
+  }
   job.source_region = rooted_spec(out["source_region"].get<std::string>(), args.root);
   job.target = path(c["target"].get<std::string>());
   job.target_region = rooted_spec(out["target_region"].get<std::string>(), args.root);
@@ -139,11 +119,9 @@ nlohmann::json run_case(const nlohmann::json& c, const RobustnessArgs& args, Sur
   job.particles = c["particles"].get<long>();
   job.threads = args.threads;
   job.quiet = true;
-  for (const std::string& p : {job.source, job.source_image, job.target}) {
-    if (!p.empty() && !fs::exists(p)) {
-      out["error"] = p + " is not present";
-      return out;
-    }
+  if (const std::string missing = missing_input(job); !missing.empty()) {
+    out["error"] = missing + " is not present";
+    return out;
   }
   try {
     const std::unique_ptr<MapSession> session = run_map_job(job, {}, {}, 1, &cache);
@@ -167,7 +145,9 @@ nlohmann::json run_case(const nlohmann::json& c, const RobustnessArgs& args, Sur
     out["verdict"] = verdict.to_json();
     nlohmann::json& m = out["methods"];
     m = nlohmann::json::object();
-    for (const MethodMeasurement& x : methods) m[x.name] = measurement_json(x);
+    for (const MethodMeasurement& x : methods) {
+      m[x.name] = measurement_json(x);
+    }
     const nlohmann::json& e = m["elastic"];
     out["elastic"] = {{"exit", verdict.exit_code()},
                       {"converged", verdict.converged},
@@ -205,15 +185,18 @@ std::string robustness_markdown(const nlohmann::json& report) {
       continue;
     }
     for (const auto& [name, value] : c["checks"].items()) {
-      if (name != "pass" && !value.get<bool>()) ++failed_checks[name];
+      if (name != "pass" && !value.get<bool>()) {
+        ++failed_checks[name];
+      }
     }
     total_seconds += c["seconds"].get<double>();
     max_seconds = std::max(max_seconds, c["seconds"].get<double>());
     const nlohmann::json& b = c["best"];
     if (b.is_object()) {
       const double sd =
-          number(c["elastic"], "symmetric_dirichlet") / number(b, "symmetric_dirichlet");
-      const double len = number(c["elastic"], "length_energy") / number(b, "length_energy");
+          json_number(c["elastic"], "symmetric_dirichlet") / json_number(b, "symmetric_dirichlet");
+      const double len =
+          json_number(c["elastic"], "length_energy") / json_number(b, "length_energy");
       if (sd > worst_sd) {
         worst_sd = sd;
         worst_sd_case = c["name"].get<std::string>();
@@ -247,18 +230,22 @@ std::string robustness_markdown(const nlohmann::json& report) {
        "over sigma^2 (the compression left after the rest scale: below 1 compresses, above 1 "
        "stretches).\n\n";
   s << "**Summary: " << passed << " of " << cases.size() << " cases pass.**";
-  if (errors > 0) s << " " << errors << " did not run (error in the table).";
+  if (errors > 0) {
+    s << " " << errors << " did not run (error in the table).";
+  }
   s << " Failed checks:";
   bool any = false;
   for (const auto& [name, count] : failed_checks) {
     s << (any ? "," : "") << ' ' << name << ' ' << count;
     any = true;
   }
-  if (!any) s << " none";
-  s << ". Worst ratios to the best baseline: symmetric Dirichlet " << fmt(worst_sd) << " ("
-    << worst_sd_case << "), length energy " << fmt(worst_len) << " (" << worst_len_case
-    << "). ElasticPaint's seconds: " << fmt(total_seconds) << " in all, at most "
-    << fmt(max_seconds) << " per case.\n\n";
+  if (!any) {
+    s << " none";
+  }
+  s << ". Worst ratios to the best baseline: symmetric Dirichlet " << fmt_number(worst_sd) << " ("
+    << worst_sd_case << "), length energy " << fmt_number(worst_len) << " (" << worst_len_case
+    << "). ElasticPaint's seconds: " << fmt_number(total_seconds) << " in all, at most "
+    << fmt_number(max_seconds) << " per case.\n\n";
 
   s << "| case | particles | area (÷σ²) | exit | converged | folds | worst σ_min | sym. Dirichlet "
        "| length energy | seconds (baselines) | pass |\n"
@@ -276,24 +263,25 @@ std::string robustness_markdown(const nlohmann::json& report) {
     const nlohmann::json& e = c["elastic"];
     const nlohmann::json& b = c["best"];
     const auto beside = [&](const std::string& key, double v, int digits) {
-      std::string text = fmt(v, digits);
+      std::string text = fmt_number(v, digits);
       if (b.is_object() && b[key].is_number()) {
-        text += " (" + initial(b, key) + fmt(b[key].get<double>(), digits) + ")";
+        text += " (" + initial(b, key) + fmt_number(b[key].get<double>(), digits) + ")";
       }
       return text;
     };
-    s << c["particles"] << " | " << fmt(number(c, "area_ratio"), 2) << " ("
-      << fmt(number(c, "area_ratio_over_sigma2"), 2) << ") | "
+    s << c["particles"] << " | " << fmt_number(json_number(c, "area_ratio"), 2) << " ("
+      << fmt_number(json_number(c, "area_ratio_over_sigma2"), 2) << ") | "
       << check_cell(c, "exit_0", std::to_string(e["exit"].get<int>())) << " | "
       << check_cell(c, "converged", e["converged"].get<bool>() ? "yes" : "no") << " | "
-      << check_cell(c, "fold_free", beside("folds", number(e, "folds"), 4)) << " | "
-      << check_cell(c, "sigma_min", beside("sigma_min", number(e, "sigma_min"), 3)) << " | "
+      << check_cell(c, "fold_free", beside("folds", json_number(e, "folds"), 4)) << " | "
+      << check_cell(c, "sigma_min", beside("sigma_min", json_number(e, "sigma_min"), 3)) << " | "
       << check_cell(c, "symmetric_dirichlet",
-                    beside("symmetric_dirichlet", number(e, "symmetric_dirichlet"), 4))
+                    beside("symmetric_dirichlet", json_number(e, "symmetric_dirichlet"), 4))
       << " | "
-      << check_cell(c, "length_energy", beside("length_energy", number(e, "length_energy"), 3))
-      << " | " << fmt(number(c, "seconds"), 2) << " (" << fmt(number(c, "seconds_baselines"), 2)
-      << ") | " << (c["pass"].get<bool>() ? "pass" : "**fail**") << " |\n";
+      << check_cell(c, "length_energy", beside("length_energy", json_number(e, "length_energy"), 3))
+      << " | " << fmt_number(json_number(c, "seconds"), 2) << " ("
+      << fmt_number(json_number(c, "seconds_baselines"), 2) << ") | "
+      << (c["pass"].get<bool>() ? "pass" : "**fail**") << " |\n";
   }
   return s.str();
 }
@@ -318,8 +306,12 @@ int run_robustness(const RobustnessArgs& args, const CLI::App& sub) {
   // case's seconds are its map, not the loading.
   SurfaceCache cache;
   for (const auto& c : cases_file["cases"]) {
-    if (!args.only.empty() && c.value("name", "") != args.only) continue;
-    if (!args.quiet) std::cerr << "elastic bench robustness: " << c.value("name", "?") << '\n';
+    if (!args.only.empty() && c.value("name", "") != args.only) {
+      continue;
+    }
+    if (!args.quiet) {
+      std::cerr << "elastic bench robustness: " << c.value("name", "?") << '\n';
+    }
     try {
       report["cases"].push_back(run_case(c, args, cache));
     } catch (const nlohmann::json::exception& e) {
@@ -336,12 +328,7 @@ int run_robustness(const RobustnessArgs& args, const CLI::App& sub) {
     }
   }
   report["summary"] = {{"cases", report["cases"].size()}, {"passed", passed}};
-  write_report(args.report, report);
-  const std::string page = robustness_markdown(report);
-  if (!args.markdown.empty()) {
-    write_file_atomically(args.markdown, [&](std::ofstream& out) { out << page; });
-  }
-  std::cout << page;
+  write_bench_outputs(args, report, robustness_markdown(report));
   return kOk;
 }
 
@@ -353,19 +340,21 @@ nlohmann::json judge_robustness_case(const nlohmann::json& elastic, const nlohma
   checks["exit_0"] = elastic.value("exit", -1) == 0;
   checks["converged"] = elastic.value("converged", false);
   checks["fold_free"] = elastic.value("folds", -1) == 0;
-  const double sigma = number(elastic, "sigma_min");
+  const double sigma = json_number(elastic, "sigma_min");
   checks["sigma_min"] = sigma >= k.min_sigma;  // false for NaN
-  const double sd = number(elastic, "symmetric_dirichlet");
-  const double len = number(elastic, "length_energy");
+  const double sd = json_number(elastic, "symmetric_dirichlet");
+  const double len = json_number(elastic, "length_energy");
   const double none = std::numeric_limits<double>::quiet_NaN();
-  const double best_sd = best.is_object() ? number(best, "symmetric_dirichlet") : none;
-  const double best_len = best.is_object() ? number(best, "length_energy") : none;
+  const double best_sd = best.is_object() ? json_number(best, "symmetric_dirichlet") : none;
+  const double best_len = best.is_object() ? json_number(best, "length_energy") : none;
   // No baseline figure to compare with: the comparison cannot fail.
   checks["symmetric_dirichlet"] = std::isnan(best_sd) || sd <= k.sd_factor * best_sd;
   checks["length_energy"] = std::isnan(best_len) || len <= k.length_factor * best_len ||
                             (best_len < k.length_floor && len <= best_len + k.length_slack);
   bool pass = true;
-  for (const auto& [name, value] : checks.items()) pass = pass && value.get<bool>();
+  for (const auto& [name, value] : checks.items()) {
+    pass = pass && value.get<bool>();
+  }
   checks["pass"] = pass;
   return checks;
 }
@@ -375,16 +364,7 @@ std::function<int()> add_robustness_subcommand(CLI::App& bench) {
   CLI::App* sub = bench.add_subcommand(
       "robustness",
       "Real meshes and ordinary choices: ElasticPaint (defaults) and the baselines, pass/fail");
-  sub->add_option("--cases", a->cases,
-                  "Cases file (JSON; default tools/benchmarks/"
-                  "robustness_cases.json)");
-  sub->add_option("--root", a->root, "Folder the cases' paths are relative to");
-  sub->add_option("--report", a->report, "Write the JSON report here (cases with `pass`)");
-  sub->add_option("--markdown", a->markdown, "Also write the Markdown table here");
-  sub->add_option("--threads", a->threads, "Threads of every stage (0: all)")
-      ->check(CLI::Range(0, 1024));
-  sub->add_option("--only", a->only, "Run only the case with this name");
-  sub->add_flag("--quiet,-q", a->quiet, "No progress lines on stderr");
+  add_bench_case_options(*sub, *a, "robustness_cases.json");
   sub->footer(
       "Example:\n  elastic bench robustness --report robustness.json --markdown robustness.md\n"
       "Prints the table on stdout; exits 0 when every case ran (passing or not).");

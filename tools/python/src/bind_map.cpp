@@ -8,6 +8,7 @@
 
 #include <Eigen/Geometry>
 #include <cmath>
+#include <functional>
 
 #include "arrays.h"
 #include "elastic/baselines/baseline_map.h"
@@ -98,6 +99,33 @@ MapOptions map_options(const MapKeywords& k) {
   return options;
 }
 
+// Runs `work` in a TBB arena of `threads` threads (0: all) without the GIL; then raises the
+// listener's error (Ctrl-C, the callback's exception), else `work`'s.
+void run_released(int threads, PythonProgress& listener, const std::function<void()>& work) {
+  std::exception_ptr failure;
+  {
+    const py::gil_scoped_release release;
+    tbb::task_arena arena(threads > 0 ? threads : tbb::task_arena::automatic);
+    try {
+      arena.execute(work);
+    } catch (...) {
+      failure = std::current_exception();
+    }
+  }
+  listener.rethrow();  // Ctrl-C or the callback's own exception wins over "cancelled"
+  if (failure) {
+    std::rethrow_exception(failure);
+  }
+}
+
+// The map's and the naive map's metrics, as `elastic map` reports them.
+void measure_state(MapState& state) {
+  state.metrics =
+      measure_on_target(state, state.result.relaxation.positions, state.result.relaxation.points);
+  state.naive_metrics =
+      measure_on_target(state, state.result.naive.positions, state.result.naive.points);
+}
+
 std::shared_ptr<MapState> run_map(const std::shared_ptr<RegionState>& source_region,
                                   const std::shared_ptr<RegionState>& target_region,
                                   const MapKeywords& keywords, const py::object& progress) {
@@ -110,27 +138,11 @@ std::shared_ptr<MapState> run_map(const std::shared_ptr<RegionState>& source_reg
   state->target = target_region->surface;
   state->source_region = source_region;
   state->target_region = target_region;
-  std::exception_ptr failure;
-  {
-    const py::gil_scoped_release release;
-    tbb::task_arena arena(keywords.threads > 0 ? keywords.threads : tbb::task_arena::automatic);
-    try {
-      arena.execute([&] {
-        state->result = map_regions(*state->source->projector, source_region->region,
-                                    *state->target->projector, target_region->region, options);
-        state->metrics = measure_on_target(*state, state->result.relaxation.positions,
-                                           state->result.relaxation.points);
-        state->naive_metrics =
-            measure_on_target(*state, state->result.naive.positions, state->result.naive.points);
-      });
-    } catch (...) {
-      failure = std::current_exception();
-    }
-  }
-  listener.rethrow();  // Ctrl-C or the callback's own exception wins over "cancelled"
-  if (failure) {
-    std::rethrow_exception(failure);
-  }
+  run_released(keywords.threads, listener, [&] {
+    state->result = map_regions(*state->source->projector, source_region->region,
+                                *state->target->projector, target_region->region, options);
+    measure_state(*state);
+  });
   return state;
 }
 
@@ -364,7 +376,8 @@ std::shared_ptr<MapState> run_decal(const std::shared_ptr<RegionState>& source_r
                                     const DecalPlacement& placement, const MapKeywords& keywords,
                                     const py::object& progress) {
   if (keywords.subdivide != 0 || keywords.boundary != "auto" || keywords.rest_scale != "auto") {
-    throw py::value_error("place_decal: a placed decal's boundary is free and its size is its scale");
+    throw py::value_error(
+        "place_decal: a placed decal's boundary is free and its size is its scale");
   }
   const MapOptions options = map_options(keywords);
   MapDecalOptions decal;
@@ -378,30 +391,14 @@ std::shared_ptr<MapState> run_decal(const std::shared_ptr<RegionState>& source_r
   state->source = source_region->surface;
   state->target = target;
   state->source_region = source_region;
-  std::exception_ptr failure;
-  {
-    const py::gil_scoped_release release;
-    tbb::task_arena arena(keywords.threads > 0 ? keywords.threads : tbb::task_arena::automatic);
-    try {
-      arena.execute([&] {
-        MapDecalResult placed = map_decal(*state->source->projector, source_region->region,
-                                          *target->projector, placement, decal);
-        state->result = std::move(placed.map);
-        state->decal = std::move(placed.geometry);
-        state->placed_region = std::move(placed.target_region);
-        state->metrics = measure_on_target(*state, state->result.relaxation.positions,
-                                           state->result.relaxation.points);
-        state->naive_metrics =
-            measure_on_target(*state, state->result.naive.positions, state->result.naive.points);
-      });
-    } catch (...) {
-      failure = std::current_exception();
-    }
-  }
-  listener.rethrow();
-  if (failure) {
-    std::rethrow_exception(failure);
-  }
+  run_released(keywords.threads, listener, [&] {
+    MapDecalResult placed = map_decal(*state->source->projector, source_region->region,
+                                      *target->projector, placement, decal);
+    state->result = std::move(placed.map);
+    state->decal = std::move(placed.geometry);
+    state->placed_region = std::move(placed.target_region);
+    measure_state(*state);
+  });
   auto region = std::make_shared<RegionState>();
   region->surface = target;
   region->region = *state->placed_region;
@@ -437,9 +434,8 @@ void bind_map(py::module_& m) {
          double angle, double scale, long particles, const std::string& solver,
          const std::string& energy, int threads, double jitter, unsigned long seed,
          long max_iterations, double curvature_radius, const py::object& progress) {
-        const DecalPlacement placement{.point = {point[0], point[1], point[2]},
-                                       .angle_degrees = angle,
-                                       .scale = scale};
+        const DecalPlacement placement{
+            .point = {point[0], point[1], point[2]}, .angle_degrees = angle, .scale = scale};
         MapKeywords k;
         k.angular_stiffness = py::none();  // the energy's default
         k.particles = particles;
