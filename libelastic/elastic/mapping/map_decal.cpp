@@ -185,25 +185,30 @@ std::unique_ptr<Region> cut_target_region(const SurfaceProjector& target, const 
     spec.points.emplace_back(relaxed.positions.col(p));
   }
   spec.anchor = spec.points.front();
-  // The cut has been seen to stop with an internal error on the polygon's closing side (rectangle
-  // -> vase half of the decal bench: "coincident curve points"; the same polygon started one point
-  // later cuts fine, to the same region). Until that is found in regions/, the polygon is tried
-  // again from its next points; the anchor stays the first particle.
+  // The cut has been seen to fail on the polygon's closing side for some starting points and not
+  // others, with an internal error ("coincident curve points") or "the curve crosses itself"
+  // (rectangle -> vase half of the decal bench: the same polygon started elsewhere cuts fine, to
+  // the same region). Until that is found in regions/, the polygon is tried from up to three
+  // starting points a seventh of the boundary apart (the anchor stays the first particle); a
+  // boundary that truly crosses itself fails from every start.
   constexpr int kStarts = 3;
+  const auto turn = static_cast<std::ptrdiff_t>(std::max<size_t>(1, spec.points.size() / 7));
   for (int start = 0;; ++start) {
     try {
       return std::make_unique<Region>(
           make_region(target, spec, {.name = name, .euclidean_bands = true}));
     } catch (const InvalidInputError& e) {
-      throw InvalidInputError(name, std::string("the decal's boundary does not bound a disk on "
-                                                "the target (") +
-                                        e.problem() + "); make it smaller");
+      if (start + 1 == kStarts) {
+        throw InvalidInputError(name, std::string("the decal's boundary does not bound a disk on "
+                                                  "the target (") +
+                                          e.problem() + "); make it smaller");
+      }
     } catch (const NumericalError&) {
       if (start + 1 == kStarts) {
         throw;
       }
-      std::rotate(spec.points.begin(), spec.points.begin() + 1, spec.points.end());
     }
+    std::rotate(spec.points.begin(), spec.points.begin() + turn, spec.points.end());
   }
 }
 
@@ -488,6 +493,9 @@ MapDecalResult map_decal(const SurfaceProjector& source, const Region& source_re
   problem.pinned = {g.pinned, g.pinned_up};
   RelaxationOptions relaxation = options.relaxation;
   relaxation.boundary = BoundaryMode::Free;
+  if (!relaxation.angular_stiffness) {
+    relaxation.angular_stiffness = kDecalAngularStiffness * relaxation.stiffness;
+  }
   map.relaxation = relax(problem, relaxation);
   if (map.relaxation.reason == StopReason::Cancelled) {
     throw Error("decal", "cancelled during relax");
