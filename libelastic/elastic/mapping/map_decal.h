@@ -58,11 +58,11 @@ DecalPlacement parse_decal_placement(const std::string& text,
 
 /// C_a / C of a placed decal's angular springs when RelaxationOptions::angular_stiffness is not
 /// set: the paper's C_a = C, not the robust energy's 0.3 (relaxation.h). With a free boundary the
-/// angular springs are what keep the boundary's shape: on the rectangles of the decal bench C_a = C
-/// turned the edges 10-50% less than 0.3 did (less than the exponential map's, where 0.3 turned
-/// them 5-15% more), kept the corners square to 0.05 degrees, and lowered the symmetric Dirichlet
-/// energy's excess by a third, for about twice the length energy (still 3-20 times below the
-/// exponential map's). Measured on spot, the sphere and Nefertiti at half the feature size.
+/// angular springs are what keep the boundary's shape: on rectangles at half the feature size
+/// (spot, the sphere, the vase, Nefertiti) C_a = C turned the edges 13-17% less than 0.3 did (less
+/// than the exponential map's, where 0.3 turned them 5-15% more), kept the corners square to 0.05
+/// degrees, and lowered the symmetric Dirichlet energy's excess by a third, for about twice the
+/// length energy (still a median 3.4 times below the exponential map's over the decal bench).
 inline constexpr double kDecalAngularStiffness = 1.0;
 
 struct MapDecalOptions {
