@@ -54,6 +54,59 @@ Eigen::Matrix3Xd unit_normals(const SurfaceProjector& projector, const InitialMa
   return normals;
 }
 
+// The grid's faces as fans of triangles, hashed by their bounding boxes on a uniform grid of
+// cells one longest edge wide (cell 0: no extent).
+struct TriangleHash {
+  std::vector<Eigen::Vector3i> triangles;
+  double cell = 0.0;
+  std::unordered_multimap<std::uint64_t, int> cells;
+
+  std::uint64_t key(const Eigen::Vector3d& x) const {
+    const Eigen::Vector3d c = (x / cell).array().floor();
+    const auto h = [](double v) {
+      return static_cast<std::uint64_t>(static_cast<std::int64_t>(v));
+    };
+    return (h(c.x()) * 73856093ULL) ^ (h(c.y()) * 19349663ULL) ^ (h(c.z()) * 83492791ULL);
+  }
+
+  TriangleHash(const ParticleGrid& grid, const Eigen::Matrix3Xd& positions) {
+    for (const auto f : grid.mesh.faces()) {
+      std::vector<int> corners;
+      for (const auto v : grid.mesh.fv_range(f)) {
+        corners.push_back(v.idx());
+      }
+      for (size_t k = 1; k + 1 < corners.size(); ++k) {
+        triangles.emplace_back(corners[0], corners[k], corners[k + 1]);
+      }
+      for (size_t k = 0; k < corners.size(); ++k) {
+        cell = std::max(
+            cell,
+            (positions.col(corners[k]) - positions.col(corners[(k + 1) % corners.size()])).norm());
+      }
+    }
+    if (!(cell > 0.0)) {
+      cell = 0.0;
+      return;
+    }
+    for (size_t t = 0; t < triangles.size(); ++t) {
+      Eigen::Vector3d low = positions.col(triangles[t][0]), high = low;
+      for (int k = 1; k < 3; ++k) {
+        low = low.cwiseMin(positions.col(triangles[t][k]));
+        high = high.cwiseMax(positions.col(triangles[t][k]));
+      }
+      const Eigen::Vector3d a = (low / cell).array().floor(), b = (high / cell).array().floor();
+      for (double x = a.x(); x <= b.x(); ++x) {
+        for (double y = a.y(); y <= b.y(); ++y) {
+          for (double z = a.z(); z <= b.z(); ++z) {
+            cells.emplace(key(Eigen::Vector3d(x + 0.5, y + 0.5, z + 0.5) * cell),
+                          static_cast<int>(t));
+          }
+        }
+      }
+    }
+  }
+};
+
 // Step 2 of the file comment: the source region's centre and frame, and every particle's tangent
 // coordinates.
 void source_frame(const Region& region, const ParticleGrid& grid, DecalGeometry& g) {
@@ -284,6 +337,64 @@ void check_decal_side(const RegionDiskMap& disk, const RelaxationResult& relaxed
   }
 }
 
+// Step 2-3 of the header: the frames, and the exponential-map start in map.naive (refused when
+// it runs off the target's boundary). Returns the grid's mean spacing on the target.
+double place_start(const Region& source_region, const SurfaceProjector& target,
+                   const MapDecalOptions& options, MapResult& map, DecalGeometry& g) {
+  const ParticleGrid& grid = map.sampling.grid;
+  const DecalPlacement& placement = g.placement;
+  source_frame(source_region, grid, g);
+  target_frame(target, options, g);
+  map.rest_scale = placement.scale;
+  double sum = 0.0;
+  for (const Spring& s : grid.springs) {
+    sum += s.rest;
+  }
+  const double spacing =
+      grid.springs.empty() ? 0.0 : placement.scale * sum / static_cast<double>(grid.springs.size());
+  ExponentialMapOptions shooting = options.shooting;
+  if (shooting.step <= 0.0) {
+    shooting.step = 0.5 * spacing;
+  }
+  std::vector<double> reached;
+  map.naive = exponential_map_placement(target.surface(), g, shooting, &reached);
+  const double reach = *std::min_element(reached.begin(), reached.end());
+  if (reach < 1.0) {
+    throw InvalidInputError(options.name,
+                            "the decal runs off the target surface's boundary; move it away from "
+                            "the edge or make it smaller: SCALE at most about " +
+                                number(0.9 * reach * placement.scale) + " (now " +
+                                number(placement.scale) + ")");
+  }
+  // The start is not checked for overlaps: where the exponential map folds (geodesics from the
+  // centre cross beyond a bump's conjugate points) the relaxation untangles it; a decal that
+  // truly wraps around a thin part still overlaps after relaxing, and is refused then.
+  return spacing;
+}
+
+// Step 4: the relaxation with a free boundary and the pinned pair.
+RelaxationResult relax_decal(const SurfaceProjector& target, const MapDecalOptions& options,
+                             const MapResult& map, const DecalGeometry& g) {
+  RelaxationProblem problem;
+  problem.grid = &map.sampling.grid;
+  problem.target = &target;
+  problem.initial_positions = map.naive.positions;
+  problem.initial_points = map.naive.points;
+  problem.rest_scale = g.placement.scale;
+  problem.rest_scale_mode = RestScale::None;
+  problem.pinned = {g.pinned, g.pinned_up};
+  RelaxationOptions relaxation = options.relaxation;
+  relaxation.boundary = BoundaryMode::Free;
+  if (!relaxation.angular_stiffness) {
+    relaxation.angular_stiffness = kDecalAngularStiffness * relaxation.stiffness;
+  }
+  RelaxationResult relaxed = relax(problem, relaxation);
+  if (relaxed.reason == StopReason::Cancelled) {
+    throw Error("decal", "cancelled during relax");
+  }
+  return relaxed;
+}
+
 }  // namespace
 
 DecalPlacement parse_decal_placement(const std::string& text, const std::string& input) {
@@ -357,52 +468,13 @@ InitialMap exponential_map_placement(const LimitSurface& target, const DecalGeom
 std::vector<int> self_overlapping_particles(const ParticleGrid& grid,
                                             const Eigen::Matrix3Xd& positions,
                                             const Eigen::Matrix3Xd& normals) {
-  // The grid's faces as fans of triangles, hashed by their bounding boxes on a uniform grid of
-  // cells one longest edge wide.
-  std::vector<Eigen::Vector3i> triangles;
-  double longest = 0.0;
-  for (const auto f : grid.mesh.faces()) {
-    std::vector<int> corners;
-    for (const auto v : grid.mesh.fv_range(f)) {
-      corners.push_back(v.idx());
-    }
-    for (size_t k = 1; k + 1 < corners.size(); ++k) {
-      triangles.emplace_back(corners[0], corners[k], corners[k + 1]);
-    }
-    for (size_t k = 0; k < corners.size(); ++k) {
-      longest = std::max(
-          longest,
-          (positions.col(corners[k]) - positions.col(corners[(k + 1) % corners.size()])).norm());
-    }
-  }
-  if (!(longest > 0.0)) {
+  const TriangleHash hashed(grid, positions);
+  if (hashed.cell <= 0.0) {
     return {};
   }
-  const double cell = longest;
-  const auto key = [&](const Eigen::Vector3d& x) {
-    const Eigen::Vector3d c = (x / cell).array().floor();
-    const auto h = [](double v) {
-      return static_cast<std::uint64_t>(static_cast<std::int64_t>(v));
-    };
-    return (h(c.x()) * 73856093ULL) ^ (h(c.y()) * 19349663ULL) ^ (h(c.z()) * 83492791ULL);
-  };
-  std::unordered_multimap<std::uint64_t, int> cells;
-  for (size_t t = 0; t < triangles.size(); ++t) {
-    Eigen::Vector3d low = positions.col(triangles[t][0]), high = low;
-    for (int k = 1; k < 3; ++k) {
-      low = low.cwiseMin(positions.col(triangles[t][k]));
-      high = high.cwiseMax(positions.col(triangles[t][k]));
-    }
-    const Eigen::Vector3d a = (low / cell).array().floor(), b = (high / cell).array().floor();
-    for (double x = a.x(); x <= b.x(); ++x) {
-      for (double y = a.y(); y <= b.y(); ++y) {
-        for (double z = a.z(); z <= b.z(); ++z) {
-          cells.emplace(key(Eigen::Vector3d(x + 0.5, y + 0.5, z + 0.5) * cell),
-                        static_cast<int>(t));
-        }
-      }
-    }
-  }
+  const std::vector<Eigen::Vector3i>& triangles = hashed.triangles;
+  const auto& cells = hashed.cells;
+  const auto key = [&](const Eigen::Vector3d& x) { return hashed.key(x); };
   std::vector<int> out;
   for (Eigen::Index p = 0; p < positions.cols(); ++p) {
     const Eigen::Vector3d x = positions.col(p);
@@ -471,56 +543,14 @@ MapDecalResult map_decal(const SurfaceProjector& source, const Region& source_re
 
   stage("place");
   start = std::chrono::steady_clock::now();
-  source_frame(source_region, grid, g);
-  target_frame(target, options, g);
-  map.rest_scale = placement.scale;
-  // The grid's mean spacing on the target.
-  double sum = 0.0;
-  for (const Spring& s : grid.springs) {
-    sum += s.rest;
-  }
-  const double spacing =
-      grid.springs.empty() ? 0.0 : placement.scale * sum / static_cast<double>(grid.springs.size());
-  ExponentialMapOptions shooting = options.shooting;
-  if (shooting.step <= 0.0) {
-    shooting.step = 0.5 * spacing;
-  }
-  std::vector<double> reached;
-  map.naive = exponential_map_placement(target.surface(), g, shooting, &reached);
-  const double reach = *std::min_element(reached.begin(), reached.end());
-  if (reach < 1.0) {
-    throw InvalidInputError(options.name,
-                            "the decal runs off the target surface's boundary; move it away from "
-                            "the edge or make it smaller: SCALE at most about " +
-                                number(0.9 * reach * placement.scale) + " (now " +
-                                number(placement.scale) + ")");
-  }
-  // The start is not checked for overlaps: where the exponential map folds (geodesics from the
-  // centre cross beyond a bump's conjugate points) the relaxation untangles it; a decal that
-  // truly wraps around a thin part still overlaps after relaxing, and is refused then.
+  const double spacing = place_start(source_region, target, options, map, g);
   g.seconds_shooting = seconds_since(start);
   map.seconds_naive = g.seconds_shooting;
 
   stage("relax");
-  RelaxationProblem problem;
-  problem.grid = &grid;
-  problem.target = &target;
-  problem.initial_positions = map.naive.positions;
-  problem.initial_points = map.naive.points;
-  problem.rest_scale = placement.scale;
-  problem.rest_scale_mode = RestScale::None;
-  problem.pinned = {g.pinned, g.pinned_up};
-  RelaxationOptions relaxation = options.relaxation;
-  relaxation.boundary = BoundaryMode::Free;
-  if (!relaxation.angular_stiffness) {
-    relaxation.angular_stiffness = kDecalAngularStiffness * relaxation.stiffness;
-  }
-  map.relaxation = relax(problem, relaxation);
-  if (map.relaxation.reason == StopReason::Cancelled) {
-    throw Error("decal", "cancelled during relax");
-  }
+  map.relaxation = relax_decal(target, options, map, g);
   const InitialMap relaxed{map.relaxation.positions, map.relaxation.points, 0};
-  check_no_overlap(grid, relaxed, target, g, options.name);
+  check_no_overlap(map.sampling.grid, relaxed, target, g, options.name);
   g.turned_degrees =
       turn_degrees(g, map.naive.positions, map.relaxation.positions, g.target_frame.normal);
 
