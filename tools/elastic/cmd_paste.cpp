@@ -532,6 +532,12 @@ ELASTIC_COMMAND(
           "\\\n"
           "      --target-anchor 0.0197,0.75,0.741 --boundary-offset anchor --out pasted/ "
           "--preview\n"
-          "`elastic locate` and `elastic region --preview` find the points (docs/cli.md, aiming).");
+          "`elastic locate` and `elastic region --preview` find the points (docs/cli.md, aiming).\n"
+          "\n"
+          "Or place the image as a decal, no target region drawn: centre, up angle, scale\n"
+          "(docs/transfer.md, placed decals):\n"
+          "  elastic paste --source-image logo.png --image-width 0.3 \\\n"
+          "      --target ../shared/meshes/spot.obj --target-place 0.356,-0.032,0.073,30,1 "
+          "--out decal/ --preview");
       return [a, &sub] { return elastic::cli::run_paste(*a, sub); };
     });
