@@ -302,10 +302,9 @@ TEST(PointsRegion, EuclideanBandsGiveTheSameRegion) {
     const double t = 2.0 * kPi * k / 48.0;
     circle.push_back(fx.on_surface(centre + 0.6 * (std::cos(t) * a + std::sin(t) * b)));
   }
-  for (const auto& polygon :
-       {circle, std::vector<Eigen::Vector3d>{fx.on_surface({1, 0.2, 0.2}),
-                                             fx.on_surface({0.2, 1, 0.2}),
-                                             fx.on_surface({0.2, 0.2, 1})}}) {
+  for (const auto& polygon : {circle, std::vector<Eigen::Vector3d>{fx.on_surface({1, 0.2, 0.2}),
+                                                                   fx.on_surface({0.2, 1, 0.2}),
+                                                                   fx.on_surface({0.2, 0.2, 1})}}) {
     const Region heat = make_region(*fx.projector, points(polygon));
     const Region chords =
         make_region(*fx.projector, points(polygon), {.name = "chords", .euclidean_bands = true});

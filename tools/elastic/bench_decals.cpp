@@ -32,12 +32,6 @@ struct DecalArgs : BenchCaseArgs {
   long particles = 0;  ///< --particles: every case's count (0: the cases file's)
 };
 
-// Unit normal du x dv of the target at a particle.
-Eigen::Vector3d normal_at(const LimitSurface& surface, const SurfacePoint& p) {
-  const SurfaceDerivatives d = surface.derivatives(p);
-  return d.du.cross(d.dv).normalized();
-}
-
 // Signed angle (degrees, counter-clockwise about n) from a to b, both projected on the plane
 // normal to n.
 double turn_deg(Eigen::Vector3d a, Eigen::Vector3d b, const Eigen::Vector3d& n) {
@@ -335,7 +329,7 @@ std::vector<double> boundary_turns(const ParticleGrid& grid, const LimitSurface&
     const int next = loop[static_cast<size_t>((k + 1) % n)];
     turns[static_cast<size_t>(k)] =
         turn_deg(positions.col(p) - positions.col(prev), positions.col(next) - positions.col(p),
-                 normal_at(surface, points[static_cast<size_t>(p)]));
+                 surface.curvature(points[static_cast<size_t>(p)]).normal);
   }
   return turns;
 }

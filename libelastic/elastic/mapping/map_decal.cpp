@@ -29,28 +29,17 @@ std::string number(double value) {
   return out.str();
 }
 
-// Unit normal du x dv at a surface point (nudged off a singular parameterisation by the
-// projector's answer at the point itself).
-Eigen::Vector3d unit_normal(const SurfaceProjector& projector, const SurfacePoint& p,
-                            const Eigen::Vector3d& position) {
-  const SurfaceDerivatives d = projector.surface().derivatives(p);
-  const Eigen::Vector3d n = d.du.cross(d.dv);
-  if (n.norm() > 1e-300) {
-    return n.normalized();
-  }
-  return projector.closest(position, p).normal;
-}
-
 Eigen::Matrix3Xd unit_normals(const SurfaceProjector& projector, const InitialMap& placement) {
   Eigen::Matrix3Xd normals(3, placement.positions.cols());
-  tbb::parallel_for(tbb::blocked_range<Eigen::Index>(0, placement.positions.cols(), 256),
-                    [&](const tbb::blocked_range<Eigen::Index>& range) {
-                      for (Eigen::Index p = range.begin(); p != range.end(); ++p) {
-                        normals.col(p) =
-                            unit_normal(projector, placement.points[static_cast<size_t>(p)],
-                                        placement.positions.col(p));
-                      }
-                    });
+  tbb::parallel_for(
+      tbb::blocked_range<Eigen::Index>(0, placement.positions.cols(), 256),
+      [&](const tbb::blocked_range<Eigen::Index>& range) {
+        for (Eigen::Index p = range.begin(); p != range.end(); ++p) {
+          // du x dv, nudged off a singular parameterisation.
+          normals.col(p) =
+              projector.surface().curvature(placement.points[static_cast<size_t>(p)]).normal;
+        }
+      });
   return normals;
 }
 
@@ -179,7 +168,7 @@ void target_frame(const SurfaceProjector& target, const MapDecalOptions& options
   }
   g.target_centre = closest.point;
   g.target_centre_position = closest.position;
-  const UpFrame frame = world_up_frame(unit_normal(target, closest.point, closest.position));
+  const UpFrame frame = world_up_frame(target.surface().curvature(closest.point).normal);
   const double a = g.placement.angle_degrees * std::numbers::pi / 180.0;
   g.target_frame.normal = frame.normal;
   g.target_frame.right = std::cos(a) * frame.right + std::sin(a) * frame.up;

@@ -14,17 +14,6 @@ namespace {
 
 constexpr const char* kName = "exponential map";
 
-// Unit normal at p, nudged off a singular parameterisation (ptex_domain.h).
-Eigen::Vector3d unit_normal(const LimitSurface& surface, const SurfacePoint& p) {
-  SurfaceDerivatives d = surface.derivatives(p);
-  Eigen::Vector3d n = d.du.cross(d.dv);
-  if (!(n.norm() > 1e-300)) {
-    d = surface.derivatives(surface.domain().towards_centre(p, kSingularNudge));
-    n = d.du.cross(d.dv);
-  }
-  return n.normalized();
-}
-
 // Arc length of a geodesic step from its chord and the normal curvature the chord shows at its two
 // ends (see the header): 2 asin(kappa c / 2) / kappa, kappa = |(n_y - n_x) . chord| / c^2.
 double arc_length(const Eigen::Vector3d& chord, const Eigen::Vector3d& normal_x,
@@ -112,7 +101,8 @@ GeodesicShot exponential_map(const LimitSurface& surface, const SurfacePoint& fr
   GeodesicShot shot;
   shot.point = from;
   shot.position = surface.position(from);
-  const Eigen::Vector3d n0 = unit_normal(surface, from);
+  // LimitSurface::curvature's normal: du x dv, nudged off a singular parameterisation.
+  const Eigen::Vector3d n0 = surface.curvature(from).normal;
   Eigen::Vector3d t = v - n0 * n0.dot(v);
   const double total = t.norm();
   if (v.norm() == 0.0) {
