@@ -155,6 +155,23 @@ TEST(SpringEnergy, BarrierSeenAlongTheNormals) {
     });
     const Eigen::Matrix3Xd barrier_gradient = gradient - spring_gradient;
     EXPECT_LT((fd - barrier_gradient).norm(), 1e-5 * barrier_gradient.norm()) << "seed " << seed;
+    // dE/dn against central differences of the energy in the unit normals (each perturbed normal
+    // normalised again): they see dE/dn's part orthogonal to n, the only part a unit normal's
+    // turning can use.
+    Eigen::Matrix3Xd normal_gradient;
+    system.evaluate(x, &gradient, &normals, &normal_gradient);
+    const Eigen::Matrix3Xd fd_normal =
+        central_differences(normals, 1e-7, [&](const Eigen::Matrix3Xd& m) {
+          const Eigen::Matrix3Xd unit = m.colwise().normalized();
+          return system.evaluate(x, nullptr, &unit).barrier;
+        });
+    Eigen::Matrix3Xd turning(3, x.cols());
+    for (Eigen::Index p = 0; p < x.cols(); ++p) {
+      const Eigen::Vector3d n = normals.col(p);
+      turning.col(p) = normal_gradient.col(p) - n * n.dot(normal_gradient.col(p));
+    }
+    EXPECT_GT(turning.norm(), 0.0);
+    EXPECT_LT((fd_normal - turning).norm(), 1e-5 * turning.norm()) << "seed " << seed;
   }
   EXPECT_GE(tested, 2);
 

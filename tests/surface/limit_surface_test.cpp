@@ -415,6 +415,54 @@ TEST(LimitSurface, TorusCurvatureMatchesTheAnalyticTorus) {
   }
 }
 
+TEST(LimitSurface, NormalVariationAdjointOnAnAnalyticSphere) {
+  // P(theta, phi) = r (sin t cos p, sin t sin p, cos t): P_t x P_p points outwards and dn(delta) =
+  // delta / r, so the adjoint of any v is its tangential part over r.
+  const double r = 1.7, t = 0.9, ph = 0.4;
+  const Eigen::Vector3d radial(std::sin(t) * std::cos(ph), std::sin(t) * std::sin(ph), std::cos(t));
+  SurfaceDerivatives d;
+  d.position = r * radial;
+  d.du = r * Eigen::Vector3d(std::cos(t) * std::cos(ph), std::cos(t) * std::sin(ph), -std::sin(t));
+  d.dv = r * Eigen::Vector3d(-std::sin(t) * std::sin(ph), std::sin(t) * std::cos(ph), 0.0);
+  d.duu = -d.position;
+  d.duv = r * Eigen::Vector3d(-std::cos(t) * std::sin(ph), std::cos(t) * std::cos(ph), 0.0);
+  d.dvv = r * Eigen::Vector3d(-std::sin(t) * std::cos(ph), -std::sin(t) * std::sin(ph), 0.0);
+  const Eigen::Vector3d v(0.3, -1.1, 0.7);
+  const Eigen::Vector3d expected = (v - radial * radial.dot(v)) / r;
+  EXPECT_LT((LimitSurface::normal_variation_adjoint(d, v) - expected).norm(), 1e-14);
+  // Degenerate derivatives: no tangent plane, no variation.
+  SurfaceDerivatives flat = d;
+  flat.dv = flat.du;
+  EXPECT_TRUE(LimitSurface::normal_variation_adjoint(flat, v).isZero(0.0));
+}
+
+TEST(LimitSurface, NormalVariationAdjointMatchesFiniteDifferencesOfTheNormal) {
+  // On the torus (every vertex regular: the limit is C2, its normal C1 everywhere) the identity
+  // v . dn(delta) = w . delta is checked against central differences of the unit normal along
+  // parameter directions (alpha, beta), delta = du alpha + dv beta.
+  const LimitSurface s(test::torus(32, 16, 1.0, 0.35), {.name = "torus"});
+  std::mt19937 rng(7);
+  std::normal_distribution<double> gauss;
+  const double h = 1e-5;
+  int checked = 0;
+  for (const SurfacePoint& p : sample_points(s, 1, 7)) {
+    if (p.u < 2 * h || p.v < 2 * h || p.u > 1 - 2 * h || p.v > 1 - 2 * h) continue;
+    const SurfaceDerivatives d = s.derivatives(p);
+    const Eigen::Vector3d v(gauss(rng), gauss(rng), gauss(rng));
+    const double alpha = gauss(rng), beta = gauss(rng);
+    auto normal = [&](double step) {
+      return s.curvature(SurfacePoint{p.face, p.u + step * alpha, p.v + step * beta}).normal;
+    };
+    const double fd = v.dot(normal(h) - normal(-h)) / (2 * h);
+    const double exact =
+        LimitSurface::normal_variation_adjoint(d, v).dot(alpha * d.du + beta * d.dv);
+    EXPECT_NEAR(exact, fd, 1e-6 * (1.0 + std::abs(fd)))
+        << "face " << p.face << " (" << p.u << ", " << p.v << ")";
+    ++checked;
+  }
+  EXPECT_GT(checked, 1000);
+}
+
 TEST(LimitSurface, CurvatureAtExtraordinaryCornersIsFinite) {
   for (const PolygonMesh& mesh : {cube(), test::mixed_solid(), test::icosphere(0, 1.0)}) {
     const LimitSurface s(mesh);

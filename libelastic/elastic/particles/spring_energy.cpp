@@ -234,6 +234,7 @@ void SpringSystem::build_barrier(const ParticleGrid& grid) {
   }
   build_incidence(num_particles_, pairs, barrier_offset_, barrier_entry_);
   barrier_force_.resize(3, 3 * static_cast<Eigen::Index>(barrier_.size()));
+  barrier_normal_force_.resize(3, static_cast<Eigen::Index>(barrier_.size()));
 }
 
 int SpringSystem::set_barrier_mask(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& normals) {
@@ -249,7 +250,8 @@ int SpringSystem::set_barrier_mask(const Eigen::Matrix3Xd& x, const Eigen::Matri
 }
 
 SpringEnergies SpringSystem::evaluate(const Eigen::Matrix3Xd& x, Eigen::Matrix3Xd* gradient,
-                                      const Eigen::Matrix3Xd* normals) const {
+                                      const Eigen::Matrix3Xd* normals,
+                                      Eigen::Matrix3Xd* normal_gradient) const {
   if (x.cols() != num_particles_) {
     throw InvalidInputError("particle positions", "expected " + std::to_string(num_particles_) +
                                                       " columns, got " + std::to_string(x.cols()));
@@ -265,6 +267,13 @@ SpringEnergies SpringSystem::evaluate(const Eigen::Matrix3Xd& x, Eigen::Matrix3X
   }
   if (want_gradient) {
     gather_gradient(with_barrier, *gradient);
+  }
+  if (normal_gradient != nullptr) {
+    if (with_barrier && normals != nullptr && want_gradient) {
+      gather_normal_gradient(*normal_gradient);
+    } else {
+      normal_gradient->setZero(3, num_particles_);
+    }
   }
   return energies;
 }
@@ -356,6 +365,7 @@ double SpringSystem::barrier_energy(const Eigen::Matrix3Xd& x, const Eigen::Matr
           const auto col = 3 * static_cast<Eigen::Index>(t);
           if (want_gradient) {
             barrier_force_.middleCols<3>(col).setZero();
+            barrier_normal_force_.col(static_cast<Eigen::Index>(t)).setZero();
           }
           if (!barrier_active_[t]) {
             continue;
@@ -364,9 +374,10 @@ double SpringSystem::barrier_energy(const Eigen::Matrix3Xd& x, const Eigen::Matr
           const Eigen::Vector3d t1 = x.col(b.prev) - x.col(b.i);
           const Eigen::Vector3d c = t0.cross(t1);
           Eigen::Vector3d m = c;
+          double seen = 0.0;  // c . n_i, with normals
           if (normals != nullptr) {
             const Eigen::Vector3d n = normals->col(b.i);
-            const double seen = c.dot(n);
+            seen = c.dot(n);
             if (!(seen > 0.0)) {
               sum += std::numeric_limits<double>::infinity();
               continue;
@@ -398,6 +409,11 @@ double SpringSystem::barrier_energy(const Eigen::Matrix3Xd& x, const Eigen::Matr
             barrier_force_.col(col) = -(f0 + f1);
             barrier_force_.col(col + 1) = f0;
             barrier_force_.col(col + 2) = f1;
+            if (normals != nullptr) {
+              // dE/dn = dE/dD dD/dn with D = (c . n)^2: -dh a / D^2 * 2 (c . n) c.
+              barrier_normal_force_.col(static_cast<Eigen::Index>(t)) =
+                  (-2.0 * dh * a_over_d2 * seen) * c;
+            }
           }
         }
         return sum;
@@ -435,6 +451,24 @@ void SpringSystem::gather_gradient(bool with_barrier, Eigen::Matrix3Xd& gradient
                           }
                         }
                         gradient.col(p) = g;
+                      }
+                    });
+}
+
+// dE/dn_p: the apex entries (role 0) of the barrier triangles, in the fixed incidence order.
+void SpringSystem::gather_normal_gradient(Eigen::Matrix3Xd& normal_gradient) const {
+  normal_gradient.resize(3, num_particles_);
+  tbb::parallel_for(tbb::blocked_range<int>(0, num_particles_, static_cast<int>(kGrain)),
+                    [&](const tbb::blocked_range<int>& range) {
+                      for (int p = range.begin(); p != range.end(); ++p) {
+                        Eigen::Vector3d g = Eigen::Vector3d::Zero();
+                        for (int k = barrier_offset_[p]; k < barrier_offset_[p + 1]; ++k) {
+                          const int code = barrier_entry_[k];
+                          if (code % 3 == 0) {
+                            g += barrier_normal_force_.col(code / 3);
+                          }
+                        }
+                        normal_gradient.col(p) = g;
                       }
                     });
 }

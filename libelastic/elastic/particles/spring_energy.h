@@ -130,9 +130,14 @@ class SpringSystem {
   /// ((T0 x T1) . n_i)^2 and a triangle with (T0 x T1) . n_i <= 0 has infinite energy, so that the
   /// barrier guards exactly what folded_corners() tests (a thin triangle standing up from the
   /// surface has a fine 3D area but is folded as seen from it). The gradient holds the normals
-  /// fixed (the solvers' steps are tangential). Without normals: the unsigned 3D area.
+  /// fixed; `normal_gradient` (with `normals` only) receives dE/dn_p, the barrier's derivative
+  /// with respect to each particle's normal (3 x #P, resized; zero where p is no active barrier
+  /// triangle's apex). A solver whose normals follow the positions on a surface (n_p = n(x_p))
+  /// adds dn/dx_p^T dE/dn_p to the gradient (LimitSurface::normal_variation_adjoint) and so
+  /// differentiates the energy it evaluates. Without normals: the unsigned 3D area.
   SpringEnergies evaluate(const Eigen::Matrix3Xd& x, Eigen::Matrix3Xd* gradient = nullptr,
-                          const Eigen::Matrix3Xd* normals = nullptr) const;
+                          const Eigen::Matrix3Xd* normals = nullptr,
+                          Eigen::Matrix3Xd* normal_gradient = nullptr) const;
 
   /// Number of grid faces with at least one folded corner at positions `x`, given unit surface
   /// normals `normals` (3 x #P) at the particles. A corner (prev, i, next) of a counter-clockwise
@@ -167,6 +172,7 @@ class SpringSystem {
   double barrier_energy(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd* normals,
                         bool want_gradient) const;
   void gather_gradient(bool with_barrier, Eigen::Matrix3Xd& gradient) const;
+  void gather_normal_gradient(Eigen::Matrix3Xd& normal_gradient) const;
 
   const ParticleGrid* grid_ = nullptr;
   SpringEnergyOptions options_;
@@ -188,10 +194,11 @@ class SpringSystem {
   std::vector<BarrierTriangle> barrier_;
   std::vector<char> barrier_active_;
   std::vector<int> barrier_offset_,
-      barrier_entry_;                       // code 3 * triangle + role (0 i, 1 next, 2 prev)
-  mutable Eigen::Matrix3Xd barrier_force_;  // 3 columns per triangle: dE/dx of i, next, prev
-  mutable Eigen::Matrix3Xd spring_force_;   // per spring: dE/dx_j
-  mutable Eigen::Matrix3Xd angular_force_;  // per angular spring: dE/dx_i
+      barrier_entry_;                              // code 3 * triangle + role (0 i, 1 next, 2 prev)
+  mutable Eigen::Matrix3Xd barrier_force_;         // 3 columns per triangle: dE/dx of i, next, prev
+  mutable Eigen::Matrix3Xd barrier_normal_force_;  // per triangle: dE/dn_i (with normals)
+  mutable Eigen::Matrix3Xd spring_force_;          // per spring: dE/dx_j
+  mutable Eigen::Matrix3Xd angular_force_;         // per angular spring: dE/dx_i
 };
 
 /// Convenience: builds a SpringSystem and evaluates it once.

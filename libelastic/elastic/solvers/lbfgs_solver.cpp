@@ -173,7 +173,8 @@ class LbfgsRun {
   // The energy, gradient and folded faces of the starting map.
   void evaluate_start() {
     resize_huge(gradient_, 3, setup_.num_particles);
-    energies_ = setup_.springs.evaluate(setup_.positions, &gradient_, &setup_.normals);
+    energies_ =
+        setup_.springs.evaluate(setup_.positions, &gradient_, &setup_.normals, &normal_gradient_);
     result_.initial_energy = energies_.total();
     result_.evaluations = 1;
     result_.initial_folded_faces = setup_.springs.folded_faces(setup_.positions, setup_.normals);
@@ -192,6 +193,8 @@ class LbfgsRun {
     setup_.springs.folded_corners(setup_.positions, setup_.normals, folded_);
     with_barrier_ = setup_.springs.options().barrier_stiffness > 0.0;
     noise_factor_ = energy_noise_factor();
+    prepare_trial_state();
+    solver_detail::add_normal_motion(setup_, normal_gradient_, &frames_, gradient_);
 
     // The solver's vectors, allocated once (see core/huge_pages.h for why that matters at scale).
     for (Eigen::VectorXd* v : {&q_, &q_free_, &direction_, &trial_q_}) {
@@ -207,7 +210,6 @@ class LbfgsRun {
     initial_norm_ = problem_.reference_gradient_norm > 0.0 ? problem_.reference_gradient_norm
                     : spring_norm > 0.0                    ? spring_norm
                                                            : q_norm_;
-    prepare_trial_state();
   }
 
   // Round-off of an energy evaluation. Each term C (|d| - k)^2 carries an error of about
@@ -517,13 +519,18 @@ class LbfgsRun {
   }
 
   // Evaluates the trial: the Armijo condition, or within the energy's round-off a smaller
-  // tangential gradient. The barrier sees each triangle along its apex normal
-  // (SpringSystem::evaluate): the current iterate's normals, held fixed through the line search, so
-  // that every trial and the slope belong to one function of the positions (with the trials' own
-  // normals, whose turning the gradient does not see, thin triangles made the Armijo test fail near
-  // the minimum).
+  // tangential gradient. The barrier sees each triangle along its apex's own surface normal
+  // (SpringSystem::evaluate), and the gradient includes the turning of those normals as the apex
+  // moves (add_normal_motion), so that every trial, every iterate and the slope belong to one
+  // function of the positions. (Normals held fixed through each line search and re-taken at the
+  // accepted point made the energy jump between iterations: the solver stalled at its iteration
+  // limit on the robustness benchmark's tightest cases.)
   bool acceptable(double alpha) {
-    trial_energies_ = setup_.springs.evaluate(trial_positions_, &trial_gradient_, &setup_.normals);
+    trial_energies_ = setup_.springs.evaluate(trial_positions_, &trial_gradient_, &trial_normals_,
+                                              &normal_gradient_);
+    if (with_barrier_) {
+      solver_detail::add_normal_motion(setup_, normal_gradient_, &trial_frames_, trial_gradient_);
+    }
     ++result_.evaluations;
     const double energy = energies_.total();
     const double trial_energy = trial_energies_.total();
@@ -587,7 +594,8 @@ class LbfgsRun {
     setup_.curve_frame(trial_s_[b], trial_points_[p], position, tangent, trial_speed_[b]);
     trial_positions_.col(col) = position;
     trial_tangents_.col(col) = tangent;
-    const SurfaceDerivatives d = setup_.target.surface().derivatives(trial_points_[p]);
+    const SurfaceDerivatives& d = trial_frames_[kk] =
+        setup_.target.surface().derivatives(trial_points_[p]);
     const Eigen::Vector3d normal = d.du.cross(d.dv);
     trial_normals_.col(col) = normal.norm() > 1e-300 ? Eigen::Vector3d(normal.normalized())
                                                      : Eigen::Vector3d(setup_.normals.col(col));
@@ -612,8 +620,7 @@ class LbfgsRun {
     trial_normals_.col(col) = out.normal;
   }
 
-  // Moves to the accepted trial: the memory's new pair, the swaps, the stall count, and the
-  // barrier taken again with the new normals.
+  // Moves to the accepted trial: the memory's new pair, the swaps, the stall count.
   void take_trial() {
     if (!trial_q_ready_) {
       layout_.tangential(trial_gradient_, trial_normals_, trial_tangents_, trial_q_);
@@ -638,13 +645,6 @@ class LbfgsRun {
                    ? stalled_ + 1
                    : 0;
     energies_ = trial_energies_;
-    if (energies_.barrier > 0.0) {
-      // At the accepted point the barrier is taken again with its own normals (nothing changes
-      // where no triangle is near collapse: the barrier is zero there).
-      energies_ = setup_.springs.evaluate(setup_.positions, &gradient_, &setup_.normals);
-      ++result_.evaluations;
-      layout_.tangential(gradient_, setup_.normals, setup_.curve_tangent, trial_q_);
-    }
     q_.swap(trial_q_);
     q_norm_ = std::sqrt(dot(q_, q_));
   }
@@ -693,6 +693,7 @@ class LbfgsRun {
 
   // Current iterate: gradient, energies, tangential gradient q (and its free rows), folded corners.
   Eigen::Matrix3Xd gradient_;
+  Eigen::Matrix3Xd normal_gradient_;  // dE/dn per particle (SpringSystem::evaluate), scratch
   SpringEnergies energies_;
   Eigen::VectorXd q_, q_free_;
   double q_norm_ = 0.0;

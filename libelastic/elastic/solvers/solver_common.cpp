@@ -263,6 +263,28 @@ double boundary_residual(const RelaxationProblem& problem, const Eigen::Matrix3X
   return residual;
 }
 
+void add_normal_motion(const RelaxationSetup& setup, const Eigen::Matrix3Xd& normal_gradient,
+                       const std::vector<SurfaceDerivatives>* frames, Eigen::Matrix3Xd& gradient) {
+  const auto n = static_cast<Eigen::Index>(setup.interior.size());
+  tbb::parallel_for(tbb::blocked_range<Eigen::Index>(0, n, 256),
+                    [&](const tbb::blocked_range<Eigen::Index>& range) {
+                      for (Eigen::Index k = range.begin(); k != range.end(); ++k) {
+                        const auto kk = static_cast<std::size_t>(k);
+                        const int p = setup.interior[kk];
+                        const Eigen::Vector3d v = normal_gradient.col(p);
+                        if (v.isZero(0.0)) {
+                          continue;
+                        }
+                        const SurfaceDerivatives frame =
+                            frames != nullptr
+                                ? (*frames)[kk]
+                                : tangent_frame(setup.target.surface(),
+                                                setup.points[static_cast<std::size_t>(p)]);
+                        gradient.col(p) += LimitSurface::normal_variation_adjoint(frame, v);
+                      }
+                    });
+}
+
 double spring_gradient_norm(const RelaxationSetup& setup) {
   SpringEnergyOptions paper = setup.springs.options();
   paper.barrier_stiffness = 0.0;
@@ -273,9 +295,10 @@ double spring_gradient_norm(const RelaxationSetup& setup) {
 
 void finish_result(const RelaxationSetup& setup, const RelaxationProblem& problem,
                    double initial_gradient_norm, RelaxationResult& result) {
-  Eigen::Matrix3Xd gradient;
+  Eigen::Matrix3Xd gradient, normal_gradient;
   const SpringEnergies energies =
-      setup.springs.evaluate(setup.positions, &gradient, &setup.normals);
+      setup.springs.evaluate(setup.positions, &gradient, &setup.normals, &normal_gradient);
+  add_normal_motion(setup, normal_gradient, nullptr, gradient);
   result.positions = setup.positions;
   result.points = setup.points;
   result.length_energy = energies.length;

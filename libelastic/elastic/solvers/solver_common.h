@@ -68,6 +68,14 @@ struct RelaxationSetup {
 double tangential_norm(const RelaxationSetup& setup, const Eigen::Matrix3Xd& gradient,
                        const Eigen::Matrix3Xd& normals);
 
+/// Adds to `gradient` the part of the barrier's gradient that comes from the normals following the
+/// free particles (SpringSystem::evaluate's `normal_gradient`, pulled back through the Weingarten
+/// map, LimitSurface::normal_variation_adjoint): with it, `gradient` is the derivative of the
+/// energy evaluated with each particle's own normal. `frames` (one per entry of setup.interior,
+/// the SurfaceDerivatives at its point) may be null: then they are evaluated here.
+void add_normal_motion(const RelaxationSetup& setup, const Eigen::Matrix3Xd& normal_gradient,
+                       const std::vector<SurfaceDerivatives>* frames, Eigen::Matrix3Xd& gradient);
+
 /// tangential_norm of the gradient of E_len + E_ang alone (no barrier) at the setup's positions.
 double spring_gradient_norm(const RelaxationSetup& setup);
 

@@ -138,6 +138,15 @@ class LimitSurface {
   /// the first and second fundamental forms, expressed in the orthonormal tangent frame (du/|du|, n
   /// x du). With degenerate derivatives (du x dv = 0) it reports zero curvature.
   static SurfaceCurvature curvature(const SurfaceDerivatives& d);
+  /// The unit normal's variation pulled back to the point: a tangent displacement delta of the
+  /// point turns n = du x dv / |du x dv| by dn(delta) = n_u alpha + n_v beta (delta = du alpha +
+  /// dv beta; the Weingarten map, minus the shape operator of SurfaceCurvature); returns the
+  /// tangent vector w with v . dn(delta) = w . delta for every tangent delta. It turns a derivative
+  /// with respect to the normal at a point into one with respect to the point's position (the
+  /// fast solver's barrier, particles/spring_energy.h). On a sphere of radius r with outward
+  /// normals, w is v's tangential part over r. Zero with degenerate derivatives (du x dv = 0).
+  static Eigen::Vector3d normal_variation_adjoint(const SurfaceDerivatives& d,
+                                                  const Eigen::Vector3d& v);
 
   /// Moves from `from` by `delta` in parameter space, continuing into neighbouring ptex faces when
   /// the straight path leaves the face (the remaining step is re-expressed in the neighbour's

@@ -72,4 +72,29 @@ SurfaceCurvature LimitSurface::curvature(const SurfacePoint& p) const {
   return curvature(d);
 }
 
+// n = N / |N| with N = du x dv: dN/du = duu x dv + du x duv, dN/dv = duv x dv + du x dvv, and the
+// unit normal's derivative is the part of dN/|N| orthogonal to n. For delta = du alpha + dv beta,
+// (alpha, beta) = I^-1 (du . delta, dv . delta) with I the first fundamental form, so
+// v . dn = (v . n_u, v . n_v) I^-1 (du . delta, dv . delta) = w . delta with
+// w = [du dv] I^-1 (v . n_u, v . n_v) (I symmetric).
+Eigen::Vector3d LimitSurface::normal_variation_adjoint(const SurfaceDerivatives& d,
+                                                       const Eigen::Vector3d& v) {
+  const Eigen::Vector3d cross = d.du.cross(d.dv);
+  const double area = cross.norm();
+  if (!(area > 0.0) || !std::isfinite(area)) {
+    return Eigen::Vector3d::Zero();
+  }
+  const Eigen::Vector3d n = cross / area;
+  const Eigen::Vector3d cross_u = d.duu.cross(d.dv) + d.du.cross(d.duv);
+  const Eigen::Vector3d cross_v = d.duv.cross(d.dv) + d.du.cross(d.dvv);
+  const Eigen::Vector3d n_u = (cross_u - n * n.dot(cross_u)) / area;
+  const Eigen::Vector3d n_v = (cross_v - n * n.dot(cross_v)) / area;
+  const double E = d.du.squaredNorm(), F = d.du.dot(d.dv), G = d.dv.squaredNorm();
+  const double det = area * area;  // E G - F^2 (Lagrange's identity, without its cancellation)
+  const double r0 = v.dot(n_u), r1 = v.dot(n_v);
+  const double y0 = (G * r0 - F * r1) / det;
+  const double y1 = (E * r1 - F * r0) / det;
+  return y0 * d.du + y1 * d.dv;
+}
+
 }  // namespace elastic
