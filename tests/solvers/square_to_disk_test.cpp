@@ -124,7 +124,7 @@ TEST(SquareToDisk, SettlesEveryParticleExceptAFewHeldAtTheCorners) {
 // reaches a fold-free equilibrium of lower energy, which is taken.
 TEST(Untangle, ExplicitStepsLeaveAFoldConstrainedStopOnTheGoblet) {
   const ShapeOptions shape{.faces = ShapeFaces::Quads, .resolution = 32, .scale = 1.0};
-  const NaiveProblem naive(shape, make_goblet(shape), "disk:0,0,0,0.85", 1000, true);
+  const NaiveProblem naive(shape, make_goblet(shape), "disk:0,0,0,0.9", 1000, true);
   const RelaxationProblem& problem = naive.problem;
 
   RelaxationOptions without;
