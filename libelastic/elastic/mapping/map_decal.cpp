@@ -463,11 +463,10 @@ std::vector<int> self_overlapping_particles(const ParticleGrid& grid,
   }
   const std::vector<Eigen::Vector3i>& triangles = hashed.triangles;
   const auto& cells = hashed.cells;
-  const auto key = [&](const Eigen::Vector3d& x) { return hashed.key(x); };
   std::vector<int> out;
   for (Eigen::Index p = 0; p < positions.cols(); ++p) {
     const Eigen::Vector3d x = positions.col(p);
-    const auto [first, last] = cells.equal_range(key(x));
+    const auto [first, last] = cells.equal_range(hashed.key(x));
     for (auto it = first; it != last; ++it) {
       const Eigen::Vector3i& t = triangles[static_cast<size_t>(it->second)];
       if (t[0] == p || t[1] == p || t[2] == p) {

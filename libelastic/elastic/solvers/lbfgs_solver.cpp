@@ -527,7 +527,7 @@ class LbfgsRun {
   // limit on the robustness benchmark's tightest cases.)
   bool acceptable(double alpha) {
     trial_energies_ = setup_.springs.evaluate(trial_positions_, &trial_gradient_, &trial_normals_,
-                                              &normal_gradient_);
+                                              with_barrier_ ? &normal_gradient_ : nullptr);
     if (with_barrier_) {
       solver_detail::add_normal_motion(setup_, normal_gradient_, &trial_frames_, trial_gradient_);
     }
