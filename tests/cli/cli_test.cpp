@@ -124,7 +124,8 @@ TEST(Cli, JobFileRepeatsTheRunAndFlagsWin) {
   const std::string report = (dir / "first.json").string();
   const CliRun first = elastic(
       "map --source " + mesh("plane_quads.obj") + " --source-region disk:0,0,0,0.8 --target " +
-          mesh("cap_quads.obj") + " --particles 150 --jitter 0.1 --seed 3 --report " + report,
+          mesh("cap_quads.obj") +
+          " --particles 150 --jitter 0.1 --seed 3 --distortion-weight 0.25 --report " + report,
       dir);
   ASSERT_EQ(first.code, 0) << first.err;
   // Nothing but results in a pipe: no progress line on stderr.
@@ -133,6 +134,8 @@ TEST(Cli, JobFileRepeatsTheRunAndFlagsWin) {
   EXPECT_EQ(a["job"]["command"], "map");
   EXPECT_EQ(a["job"]["particles"], 150);
   EXPECT_EQ(a["job"]["seed"], 3);
+  EXPECT_EQ(a["job"]["distortion-weight"], 0.25);
+  EXPECT_GT(a["energy"]["distortion"].get<double>(), 0.0);
   // The report itself is a job file: the same run again, except for the report path.
   const std::string second = (dir / "second.json").string();
   ASSERT_EQ(elastic("map --job " + report + " --report " + second, dir).code, 0);
@@ -140,6 +143,7 @@ TEST(Cli, JobFileRepeatsTheRunAndFlagsWin) {
   EXPECT_EQ(b["particles"], a["particles"]);
   EXPECT_EQ(b["iterations"], a["iterations"]);
   EXPECT_EQ(b["energy"]["length"], a["energy"]["length"]);  // deterministic: bit-identical
+  EXPECT_EQ(b["energy"]["distortion"], a["energy"]["distortion"]);
   // A flag on the command line wins over the job file.
   const std::string third = (dir / "third.json").string();
   ASSERT_EQ(elastic("map --job " + report + " --particles 100 --report " + third, dir).code, 0);

@@ -5,8 +5,10 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
 #include <cmath>
 #include <random>
+#include <utility>
 
 #include "elastic/core/error.h"
 #include "solvers/solver_fixtures.h"
@@ -116,10 +118,55 @@ TEST(SpringEnergy, BarrierGradientMatchesFiniteDifferences) {
   EXPECT_GE(tested, 2);
 }
 
+// The terms over grid triangles (E_bar + E_sd) at x seen along `normals`: their gradient, normals
+// held fixed, against central differences in x, and dE/dn against central differences in the unit
+// normals (each perturbed normal normalised again): those see dE/dn's part orthogonal to n, the
+// only part a unit normal's turning can use. Returns false (nothing tested) where the terms are
+// zero or infinite there.
+bool expect_triangle_gradients(const SpringSystem& system, const SpringSystem& springs_only,
+                               const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& normals) {
+  const auto terms = [](const SpringEnergies& e) { return e.barrier + e.distortion; };
+  Eigen::Matrix3Xd gradient, spring_gradient, normal_gradient;
+  const double value = terms(system.evaluate(x, &gradient, &normals, &normal_gradient));
+  if (!std::isfinite(value) || !(value > 0.0)) {
+    return false;
+  }
+  springs_only.evaluate(x, &spring_gradient);
+  const Eigen::Matrix3Xd fd = central_differences(x, 1e-6, [&](const Eigen::Matrix3Xd& y) {
+    return terms(system.evaluate(y, nullptr, &normals));
+  });
+  const Eigen::Matrix3Xd triangle_gradient = gradient - spring_gradient;
+  EXPECT_LT((fd - triangle_gradient).norm(), 1e-5 * triangle_gradient.norm());
+  const Eigen::Matrix3Xd fd_normal =
+      central_differences(normals, 1e-7, [&](const Eigen::Matrix3Xd& m) {
+        const Eigen::Matrix3Xd unit = m.colwise().normalized();
+        return terms(system.evaluate(x, nullptr, &unit));
+      });
+  Eigen::Matrix3Xd turning(3, x.cols());
+  for (Eigen::Index p = 0; p < x.cols(); ++p) {
+    const Eigen::Vector3d n = normals.col(p);
+    turning.col(p) = normal_gradient.col(p) - n * n.dot(normal_gradient.col(p));
+  }
+  EXPECT_GT(turning.norm(), 0.0);
+  EXPECT_LT((fd_normal - turning).norm(), 1e-5 * turning.norm());
+  return true;
+}
+
+// Heights and tilted unit normals from a seed: a grid lifted off its plane.
+void lift_off_the_plane(unsigned seed, Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& normals) {
+  std::mt19937 rng(seed + 100);
+  std::uniform_real_distribution<double> u(-0.15, 0.15);
+  normals.resize(3, x.cols());
+  for (Eigen::Index p = 0; p < x.cols(); ++p) {
+    x(2, p) = u(rng);
+    normals.col(p) = Eigen::Vector3d(u(rng), u(rng), 1.0).normalized();
+  }
+}
+
 // With normals the barrier sees each triangle's area along its apex normal: on a plane with the
 // plane's normal it is the 3D barrier exactly; off the plane (normals tilted, heights random) its
-// gradient, normals held fixed, matches central differences; a triangle that stands up from the
-// surface (its plane containing the normal) has a finite 3D barrier but is infinite as seen.
+// gradients match central differences (expect_triangle_gradients); a triangle that stands up from
+// the surface (its plane containing the normal) has a finite 3D barrier but is infinite as seen.
 TEST(SpringEnergy, BarrierSeenAlongTheNormals) {
   const ParticleGrid grid = test::make_quad_grid(4, 3, 1.0);
   const SpringSystem system(grid, barrier_test_options(true));
@@ -135,43 +182,9 @@ TEST(SpringEnergy, BarrierSeenAlongTheNormals) {
       continue;
     }
     EXPECT_NEAR(system.evaluate(x, nullptr, &up).barrier, planar, 1e-12 * planar);
-    // Off the plane: heights and tilted normals from the same seed.
-    std::mt19937 rng(seed + 100);
-    std::uniform_real_distribution<double> u(-0.15, 0.15);
-    Eigen::Matrix3Xd normals(3, x.cols());
-    for (Eigen::Index p = 0; p < x.cols(); ++p) {
-      x(2, p) = u(rng);
-      normals.col(p) = Eigen::Vector3d(u(rng), u(rng), 1.0).normalized();
-    }
-    Eigen::Matrix3Xd gradient, spring_gradient;
-    const SpringEnergies e = system.evaluate(x, &gradient, &normals);
-    if (!std::isfinite(e.barrier) || !(e.barrier > 0.0)) {
-      continue;
-    }
-    ++tested;
-    springs_only.evaluate(x, &spring_gradient);
-    const Eigen::Matrix3Xd fd = central_differences(x, 1e-6, [&](const Eigen::Matrix3Xd& y) {
-      return system.evaluate(y, nullptr, &normals).barrier;
-    });
-    const Eigen::Matrix3Xd barrier_gradient = gradient - spring_gradient;
-    EXPECT_LT((fd - barrier_gradient).norm(), 1e-5 * barrier_gradient.norm()) << "seed " << seed;
-    // dE/dn against central differences of the energy in the unit normals (each perturbed normal
-    // normalised again): they see dE/dn's part orthogonal to n, the only part a unit normal's
-    // turning can use.
-    Eigen::Matrix3Xd normal_gradient;
-    system.evaluate(x, &gradient, &normals, &normal_gradient);
-    const Eigen::Matrix3Xd fd_normal =
-        central_differences(normals, 1e-7, [&](const Eigen::Matrix3Xd& m) {
-          const Eigen::Matrix3Xd unit = m.colwise().normalized();
-          return system.evaluate(x, nullptr, &unit).barrier;
-        });
-    Eigen::Matrix3Xd turning(3, x.cols());
-    for (Eigen::Index p = 0; p < x.cols(); ++p) {
-      const Eigen::Vector3d n = normals.col(p);
-      turning.col(p) = normal_gradient.col(p) - n * n.dot(normal_gradient.col(p));
-    }
-    EXPECT_GT(turning.norm(), 0.0);
-    EXPECT_LT((fd_normal - turning).norm(), 1e-5 * turning.norm()) << "seed " << seed;
+    Eigen::Matrix3Xd normals;
+    lift_off_the_plane(seed, x, normals);
+    tested += expect_triangle_gradients(system, springs_only, x, normals) ? 1 : 0;
   }
   EXPECT_GE(tested, 2);
 
@@ -213,6 +226,49 @@ TEST(SpringEnergy, BarrierValueOfAUniformCompression) {
   EXPECT_TRUE(std::isinf(system.evaluate(line).barrier));
 }
 
+// The distortion term of an affine stretch by (s1, s2) of the whole grid at rest scale sigma,
+// turned by a rotation: every triangle's affine map divided by sigma has singular values s1, s2,
+// so E_sd = lambda C sigma^2 A (s1^2 + s2^2 + s1^-2 + s2^-2 - 4), A the grid's area. A rigid
+// motion at the rest scale has none; the barrier, off, stays 0.
+TEST(SpringEnergy, DistortionValueOfAnAffineStretch) {
+  const ParticleGrid grid = test::make_quad_grid(4, 3, 1.0);
+  const double lambda = 0.5, C = 2.0, sigma = 0.8, area = 12.0;
+  const SpringSystem system(grid, {.stiffness = C,
+                                   .angular_stiffness = 0.0,
+                                   .rest_scale = sigma,
+                                   .barrier_stiffness = 0.0,
+                                   .distortion_stiffness = lambda});
+  const Eigen::Matrix3d turn =
+      Eigen::AngleAxisd(0.7, Eigen::Vector3d(1.0, -2.0, 0.5).normalized()).toRotationMatrix();
+  for (const auto& [s1, s2] : {std::pair{1.0, 1.0}, {0.5, 1.0}, {1.3, 0.7}, {2.0, 3.0}}) {
+    const Eigen::Vector3d stretch(sigma * s1, sigma * s2, 0.0);
+    const Eigen::Matrix3Xd x = turn * (stretch.asDiagonal() * test::grid_positions(grid));
+    const double expected =
+        lambda * C * sigma * sigma * area * (s1 * s1 + s2 * s2 + 1 / (s1 * s1) + 1 / (s2 * s2) - 4);
+    const SpringEnergies e = system.evaluate(x);
+    EXPECT_NEAR(e.distortion, expected, 1e-10 * (1.0 + expected)) << s1 << " x " << s2;
+    EXPECT_EQ(e.barrier, 0.0);
+  }
+}
+
+// The distortion term's gradients (with the barrier, both on) off the plane against central
+// differences, as the barrier's.
+TEST(SpringEnergy, DistortionSeenAlongTheNormals) {
+  const ParticleGrid grid = test::make_quad_grid(4, 3, 1.0);
+  SpringEnergyOptions options = barrier_test_options(true);
+  options.distortion_stiffness = 0.8;
+  const SpringSystem system(grid, options);
+  const SpringSystem springs_only(grid, barrier_test_options(false));
+  int tested = 0;
+  for (unsigned seed = 1; seed <= 8; ++seed) {
+    Eigen::Matrix3Xd x = random_configuration(grid, 0.3, seed);
+    Eigen::Matrix3Xd normals;
+    lift_off_the_plane(seed, x, normals);
+    tested += expect_triangle_gradients(system, springs_only, x, normals) ? 1 : 0;
+  }
+  EXPECT_GE(tested, 4);
+}
+
 // The target's units are the user's: with the rest scale sigma and the positions both multiplied
 // by lambda, every term (springs and barrier alike) is multiplied by lambda^2, so the minimiser is
 // the same map whatever the two meshes' units. (The barrier once weighed the source area without
@@ -227,17 +283,20 @@ TEST(SpringEnergy, EveryTermScalesWithTheSquareOfTheTargetUnits) {
                                      .angular_stiffness = 0.4,
                                      .rest_scale = 0.8 * lambda,
                                      .barrier_stiffness = 2.0,
-                                     .barrier_sigma = 0.4});
+                                     .barrier_sigma = 0.4,
+                                     .distortion_stiffness = 0.3});
     return system.evaluate(Eigen::Matrix3Xd(lambda * x));
   };
   const SpringEnergies unit = energies(1.0);
   ASSERT_GT(unit.barrier, 0.0);
+  ASSERT_GT(unit.distortion, 0.0);
   for (const double lambda : {1e-3, 0.37, 44.7, 2.5e3}) {
     const SpringEnergies scaled = energies(lambda);
     const double l2 = lambda * lambda;
     EXPECT_NEAR(scaled.length, l2 * unit.length, 1e-10 * l2 * unit.length) << lambda;
     EXPECT_NEAR(scaled.angular, l2 * unit.angular, 1e-10 * l2 * unit.angular) << lambda;
     EXPECT_NEAR(scaled.barrier, l2 * unit.barrier, 1e-10 * l2 * unit.barrier) << lambda;
+    EXPECT_NEAR(scaled.distortion, l2 * unit.distortion, 1e-10 * l2 * unit.distortion) << lambda;
   }
 }
 

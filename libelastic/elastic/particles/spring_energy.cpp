@@ -175,7 +175,10 @@ SpringSystem::SpringSystem(const ParticleGrid& grid, const SpringEnergyOptions& 
                             "barrier stiffness must be finite and non-negative and its "
                             "threshold in (0, 1)");
   }
-  if (options.barrier_stiffness > 0.0) {
+  if (!finite_non_negative(options.distortion_stiffness)) {
+    throw InvalidInputError(name, "distortion stiffness must be finite and non-negative");
+  }
+  if (options.triangle_terms()) {
     build_barrier(grid);
   }
 
@@ -261,9 +264,11 @@ SpringEnergies SpringSystem::evaluate(const Eigen::Matrix3Xd& x, Eigen::Matrix3X
   energies.length = length_energy(x, want_gradient);
   energies.angular = angular_energy(x, want_gradient);
   const bool with_barrier =
-      options_.barrier_stiffness * options_.stiffness > 0.0 && !barrier_.empty();
+      options_.triangle_terms() && options_.stiffness > 0.0 && !barrier_.empty();
   if (with_barrier) {
-    energies.barrier = barrier_energy(x, normals, want_gradient);
+    const Eigen::Vector2d triangles = triangle_energy(x, normals, want_gradient);
+    energies.barrier = triangles[0];
+    energies.distortion = triangles[1];
   }
   if (want_gradient) {
     gather_gradient(with_barrier, *gradient);
@@ -337,18 +342,20 @@ double SpringSystem::angular_energy(const Eigen::Matrix3Xd& x, bool want_gradien
       std::plus<double>());
 }
 
-// Injectivity barrier (header): mu C w A h(g), g = sigma^2 tr(B G) det(S^T S) / D with
+// Terms over grid triangles (header): E_bar and E_sd, returned as (E_bar, E_sd).
+// Injectivity barrier: mu C w A h(g), g = sigma^2 tr(B G) det(S^T S) / D with
 // G = T^T T the target Gram matrix and D = det(G) = |c|^2, c = T0 x T1 (Lagrange's identity;
 // the cross product keeps a sliver's D accurate where G00 G11 - G01^2 would cancel to
 // round-off), or with normals D = (c . n)^2, the area seen along the apex normal n (header).
-// With q = sigma^2 det(S^T S), a = tr(B G) and m = c (or (c . n) n):
-//   dg/dT = q (da/dT / D - a dD/dT / D^2),
+// With q = sigma^2 det(S^T S), a = tr(B G) and m = c (or (c . n) n), both terms are functions
+// of a and D (dg/da = q / D, dg/dD = -g / D), so dE/dT = dE/da da/dT + dE/dD dD/dT with
 //   da/dT0 = 2 (b00 T0 + b01 T1),   da/dT1 = 2 (b11 T1 + b01 T0),
 //   dD/dT0 = 2 T1 x m,              dD/dT1 = 2 m x T0.
 // A collapsed (or, with normals, inverted) target triangle has infinite energy: the line search
 // backs off.
-double SpringSystem::barrier_energy(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd* normals,
-                                    bool want_gradient) const {
+Eigen::Vector2d SpringSystem::triangle_energy(const Eigen::Matrix3Xd& x,
+                                              const Eigen::Matrix3Xd* normals,
+                                              bool want_gradient) const {
   const double mu = options_.barrier_stiffness * options_.stiffness;
   const double sigma = options_.rest_scale;
   if (normals != nullptr && normals->cols() != num_particles_) {
@@ -357,9 +364,10 @@ double SpringSystem::barrier_energy(const Eigen::Matrix3Xd& x, const Eigen::Matr
                                                     std::to_string(normals->cols()));
   }
   const double g0 = 1.0 / (options_.barrier_sigma * options_.barrier_sigma);
+  const double lambda = options_.distortion_stiffness * options_.stiffness;
   return tbb::parallel_deterministic_reduce(
-      tbb::blocked_range<std::size_t>(0, barrier_.size(), kGrain), 0.0,
-      [&](const tbb::blocked_range<std::size_t>& range, double sum) {
+      tbb::blocked_range<std::size_t>(0, barrier_.size(), kGrain), Eigen::Vector2d(0.0, 0.0),
+      [&](const tbb::blocked_range<std::size_t>& range, Eigen::Vector2d sum) {
         for (std::size_t t = range.begin(); t != range.end(); ++t) {
           const BarrierTriangle& b = barrier_[t];
           const auto col = 3 * static_cast<Eigen::Index>(t);
@@ -379,46 +387,65 @@ double SpringSystem::barrier_energy(const Eigen::Matrix3Xd& x, const Eigen::Matr
             const Eigen::Vector3d n = normals->col(b.i);
             seen = c.dot(n);
             if (!(seen > 0.0)) {
-              sum += std::numeric_limits<double>::infinity();
+              sum[0] += std::numeric_limits<double>::infinity();
               continue;
             }
             m = seen * n;
           }
           const double D = m.squaredNorm();
           if (!(D > 0.0)) {
-            sum += std::numeric_limits<double>::infinity();
+            sum[0] += std::numeric_limits<double>::infinity();
             continue;
           }
           const double a =
               b.b00 * t0.squaredNorm() + 2.0 * b.b01 * t0.dot(t1) + b.b11 * t1.squaredNorm();
           const double q = sigma * sigma * b.source_det;
           const double g = q * a / D;
-          if (!(g > g0)) {
+          // dE/da and dE/dD of each term; the barrier's (dh = dE/dg q: dE/da = dh / D, dE/dD =
+          // -dh a / D^2) in the form the barrier had alone, so its bits do not depend on E_sd.
+          double dh = 0.0, sd_da = 0.0, sd_dd = 0.0;
+          if (g > g0) {
+            const double r = g / g0 - 1.0;
+            sum[0] += mu * b.weight * r * r * r;
+            dh = mu * b.weight * 3.0 * r * r / g0 * q;
+          }
+          if (lambda > 0.0) {
+            // E_sd: lambda w (a / sigma^2 + g - 4), dg/da = q / D, dg/dD = -g / D.
+            sum[1] += lambda * b.weight * (a / (sigma * sigma) + g - 4.0);
+            sd_da = lambda * b.weight * (1.0 / (sigma * sigma) + q / D);
+            sd_dd = -lambda * b.weight * g / D;
+          }
+          if (!want_gradient || (dh == 0.0 && sd_da == 0.0 && sd_dd == 0.0)) {
             continue;
           }
-          const double r = g / g0 - 1.0;
-          sum += mu * b.weight * r * r * r;
-          if (want_gradient) {
-            const double dh = mu * b.weight * 3.0 * r * r / g0 * q;  // dE/dg times q
-            const double over_d = 1.0 / D, a_over_d2 = a / (D * D);
-            // dE/dx_next and dE/dx_prev
-            const Eigen::Vector3d f0 =
-                dh * (2.0 * over_d * (b.b00 * t0 + b.b01 * t1) - 2.0 * a_over_d2 * t1.cross(m));
-            const Eigen::Vector3d f1 =
-                dh * (2.0 * over_d * (b.b11 * t1 + b.b01 * t0) - 2.0 * a_over_d2 * m.cross(t0));
-            barrier_force_.col(col) = -(f0 + f1);
-            barrier_force_.col(col + 1) = f0;
-            barrier_force_.col(col + 2) = f1;
-            if (normals != nullptr) {
-              // dE/dn = dE/dD dD/dn with D = (c . n)^2: -dh a / D^2 * 2 (c . n) c.
-              barrier_normal_force_.col(static_cast<Eigen::Index>(t)) =
-                  (-2.0 * dh * a_over_d2 * seen) * c;
-            }
+          const double over_d = 1.0 / D, a_over_d2 = a / (D * D);
+          const Eigen::Vector3d da0 = 2.0 * (b.b00 * t0 + b.b01 * t1);             // da/dT0
+          const Eigen::Vector3d da1 = 2.0 * (b.b11 * t1 + b.b01 * t0);             // da/dT1
+          const Eigen::Vector3d dd0 = 2.0 * t1.cross(m), dd1 = 2.0 * m.cross(t0);  // dD/dT0, dD/dT1
+          // dE/dx_next and dE/dx_prev
+          Eigen::Vector3d f0 = Eigen::Vector3d::Zero(), f1 = Eigen::Vector3d::Zero();
+          double de_dd = 0.0;
+          if (dh != 0.0) {
+            f0 = dh * (over_d * da0 - a_over_d2 * dd0);
+            f1 = dh * (over_d * da1 - a_over_d2 * dd1);
+            de_dd = -dh * a_over_d2;
+          }
+          if (lambda > 0.0) {
+            f0 += sd_da * da0 + sd_dd * dd0;
+            f1 += sd_da * da1 + sd_dd * dd1;
+            de_dd += sd_dd;
+          }
+          barrier_force_.col(col) = -(f0 + f1);
+          barrier_force_.col(col + 1) = f0;
+          barrier_force_.col(col + 2) = f1;
+          if (normals != nullptr) {
+            // dE/dn = dE/dD dD/dn with D = (c . n)^2: dE/dD * 2 (c . n) c.
+            barrier_normal_force_.col(static_cast<Eigen::Index>(t)) = (2.0 * de_dd * seen) * c;
           }
         }
         return sum;
       },
-      std::plus<double>());
+      std::plus<Eigen::Vector2d>());
 }
 
 // Gathers the forces per particle in the fixed incidence order: no races, same bits for any thread

@@ -45,6 +45,15 @@
 ///   sigma_min away from 0 (no slivers under compression), and so no triangle can fold. Triangles
 ///   already inverted where the barrier is switched on (set_barrier_mask) are left out of it.
 ///
+/// - distortion term (beyond the paper; SpringEnergyOptions::distortion_stiffness > 0):
+///       E_sd = lambda * sum_t w_t sigma^2 A_t * (s1^2 + s2^2 + s1^-2 + s2^-2 - 4)
+///   over the barrier's triangles: the symmetric Dirichlet energy of each triangle's affine map
+///   divided by sigma (metrics/map_metrics.h), zero for an isometry at the rest scale. In the
+///   Gram form above, s1^2 + s2^2 = tr((S^T S)^-1 T^T T) / sigma^2 and s1^-2 + s2^-2 = g. The
+///   springs see lengths along grid edges only; this term also sees shear, which a quad grid's
+///   springs let through cheaply (on a hump, a length-preserving map trades angles for lengths).
+///   It is itself infinite at collapse, and it leaves the barrier's triangles out in the same way.
+///
 /// Degenerate springs: at |d| = 0 (or |e| = 0) the energy has a cone point and no gradient; that
 /// spring then contributes zero to the gradient (a valid subgradient choice that keeps the sum of
 /// forces zero).
@@ -101,14 +110,21 @@ struct SpringEnergyOptions {
   /// The smaller stretch (divided by sigma) below which the barrier starts to act, about; in
   /// (0, 1).
   double barrier_sigma = 0.4;
+  /// lambda of the distortion term E_sd (see the file comment), relative to C: its weight is
+  /// lambda * C. 0: off. It trades length for angle fidelity (docs/solvers.md).
+  double distortion_stiffness = 0.0;
+
+  /// Whether the terms over grid triangles (E_bar, E_sd) are on.
+  bool triangle_terms() const { return barrier_stiffness > 0.0 || distortion_stiffness > 0.0; }
 };
 
 /// Energies per term.
 struct SpringEnergies {
-  double length = 0.0;   ///< E_len (eq. 13)
-  double angular = 0.0;  ///< E_ang
-  double barrier = 0.0;  ///< E_bar (0 when the barrier is off)
-  double total() const { return length + angular + barrier; }
+  double length = 0.0;      ///< E_len (eq. 13)
+  double angular = 0.0;     ///< E_ang
+  double barrier = 0.0;     ///< E_bar (0 when the barrier is off)
+  double distortion = 0.0;  ///< E_sd (0 when it is off)
+  double total() const { return length + angular + barrier + distortion; }
 };
 
 /// The spring energies of one ParticleGrid, with the incidence tables precomputed for fast,
@@ -169,8 +185,8 @@ class SpringSystem {
   // gather of those forces into the gradient.
   double length_energy(const Eigen::Matrix3Xd& x, bool want_gradient) const;
   double angular_energy(const Eigen::Matrix3Xd& x, bool want_gradient) const;
-  double barrier_energy(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd* normals,
-                        bool want_gradient) const;
+  Eigen::Vector2d triangle_energy(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd* normals,
+                                  bool want_gradient) const;
   void gather_gradient(bool with_barrier, Eigen::Matrix3Xd& gradient) const;
   void gather_normal_gradient(Eigen::Matrix3Xd& normal_gradient) const;
 

@@ -191,7 +191,7 @@ class LbfgsRun {
     held_.assign(static_cast<std::size_t>(n_), 0);
     resize_huge(solved_, m_, 1);
     setup_.springs.folded_corners(setup_.positions, setup_.normals, folded_);
-    with_barrier_ = setup_.springs.options().barrier_stiffness > 0.0;
+    with_barrier_ = setup_.springs.options().triangle_terms();
     noise_factor_ = energy_noise_factor();
     prepare_trial_state();
     solver_detail::add_normal_motion(setup_, normal_gradient_, &frames_, gradient_);

@@ -176,6 +176,11 @@ struct RelaxationOptions {
   double barrier_stiffness = 15.0;
   /// Smaller stretch below which the barrier acts (SpringEnergyOptions::barrier_sigma).
   double barrier_sigma = 0.4;
+  /// lambda of the distortion term relative to C (SpringEnergyOptions::distortion_stiffness);
+  /// Robust only. 0 (off) by default: on the robustness benchmark 0.2 brings the two spot-back
+  /// cases' symmetric Dirichlet within 1.02x of DCM's, but lifts the square and rectangle cases'
+  /// length energy past 0.9x the best baseline's (docs/solvers.md).
+  double distortion_stiffness = 0.0;
   double stiffness = 1.0;  ///< C of the normal springs (eq. 13)
   /// C_a of the angular springs; empty: the energy's default (kPaperAngularStiffness or
   /// kRobustAngularStiffness times `stiffness`), see angular_stiffness(const RelaxationOptions&).
@@ -256,6 +261,7 @@ struct RelaxationResult {
   double length_energy = 0.0;              ///< final E_len (eq. 13)
   double angular_energy = 0.0;             ///< final E_ang
   double barrier_energy = 0.0;             ///< final E_bar (0 with EnergyKind::Paper)
+  double distortion_energy = 0.0;          ///< final E_sd (0 when off)
   double angular_stiffness = 0.0;          ///< C_a of the run (angular_stiffness(options))
   EnergyKind energy = EnergyKind::Robust;  ///< the energy minimised (Paper for the faithful solver)
   /// Robust energy: runs of the paper's energy (with untangling) that were needed first because

@@ -37,7 +37,8 @@ SpringEnergyOptions energy_options(const RelaxationProblem& problem,
           .angular_stiffness = angular_stiffness(options),
           .rest_scale = problem.rest_scale,
           .barrier_stiffness = barrier ? options.barrier_stiffness : 0.0,
-          .barrier_sigma = options.barrier_sigma};
+          .barrier_sigma = options.barrier_sigma,
+          .distortion_stiffness = barrier ? options.distortion_stiffness : 0.0};
 }
 
 void check_problem(const RelaxationProblem& problem, const RelaxationOptions& options,
@@ -288,6 +289,7 @@ void add_normal_motion(const RelaxationSetup& setup, const Eigen::Matrix3Xd& nor
 double spring_gradient_norm(const RelaxationSetup& setup) {
   SpringEnergyOptions paper = setup.springs.options();
   paper.barrier_stiffness = 0.0;
+  paper.distortion_stiffness = 0.0;
   Eigen::Matrix3Xd gradient;
   SpringSystem(setup.grid, paper).evaluate(setup.positions, &gradient);
   return tangential_norm(setup, gradient, setup.normals);
@@ -304,9 +306,9 @@ void finish_result(const RelaxationSetup& setup, const RelaxationProblem& proble
   result.length_energy = energies.length;
   result.angular_energy = energies.angular;
   result.barrier_energy = energies.barrier;
+  result.distortion_energy = energies.distortion;
   result.angular_stiffness = setup.springs.options().angular_stiffness;
-  result.energy =
-      setup.springs.options().barrier_stiffness > 0.0 ? EnergyKind::Robust : EnergyKind::Paper;
+  result.energy = setup.springs.options().triangle_terms() ? EnergyKind::Robust : EnergyKind::Paper;
   result.initial_gradient_norm = initial_gradient_norm;
   result.gradient_norm = tangential_norm(setup, gradient, setup.normals);
   result.relative_gradient =

@@ -42,6 +42,7 @@ struct MapKeywords {
   unsigned long seed = 0;
   long max_iterations = 0;
   double curvature_radius = AdaptiveSamplingOptions{}.curvature_radius;
+  double distortion_weight = 0.0;
 };
 
 // The MapOptions of `elastic map` for the same flags (tools/elastic/map_job.cpp).
@@ -95,6 +96,11 @@ MapOptions map_options(const MapKeywords& k) {
     }
     options.relaxation.angular_stiffness = ca;
   }
+  if (!(k.distortion_weight >= 0.0 && k.distortion_weight <= 100.0)) {
+    throw py::value_error("distortion_weight: expected lambda / C in [0, 100], got " +
+                          std::to_string(k.distortion_weight));
+  }
+  options.relaxation.distortion_stiffness = k.distortion_weight;
   options.subdivisions = k.subdivide;
   return options;
 }
@@ -469,11 +475,11 @@ void bind_map(py::module_& m) {
          const std::string& boundary, const std::string& boundary_offset,
          const std::string& preconditioner, const py::object& angular_stiffness, int subdivide,
          int threads, double jitter, unsigned long seed, long max_iterations,
-         double curvature_radius, const py::object& progress) {
-        const MapKeywords k{particles,      solver,          energy,         rest_scale,
-                            boundary,       boundary_offset, preconditioner, angular_stiffness,
-                            subdivide,      threads,         jitter,         seed,
-                            max_iterations, curvature_radius};
+         double curvature_radius, double distortion_weight, const py::object& progress) {
+        const MapKeywords k{particles,      solver,           energy,           rest_scale,
+                            boundary,       boundary_offset,  preconditioner,   angular_stiffness,
+                            subdivide,      threads,          jitter,           seed,
+                            max_iterations, curvature_radius, distortion_weight};
         return run_map(source_region, target_region, k, progress);
       },
       py::arg("source_region"), py::arg("target_region"), py::kw_only(),
@@ -483,7 +489,7 @@ void bind_map(py::module_& m) {
       py::arg("angular_stiffness") = py::none(), py::arg("subdivide") = 0, py::arg("threads") = 0,
       py::arg("jitter") = 0.0, py::arg("seed") = 0, py::arg("max_iterations") = 0,
       py::arg("curvature_radius") = AdaptiveSamplingOptions{}.curvature_radius,
-      py::arg("progress") = py::none(),
+      py::arg("distortion_weight") = 0.0, py::arg("progress") = py::none(),
       "Maps source_region onto target_region (each a Region of its Surface) with the particle "
       "system: the keywords are the flags of `elastic map` (docs/cli.md) with underscores. "
       "progress: called as progress(stage, iteration, total, energy, gradient); return False to "
@@ -530,6 +536,7 @@ void bind_map(py::module_& m) {
             e["length"] = x.length_energy;
             e["angle"] = x.angular_energy;
             e["barrier"] = x.barrier_energy;
+            e["distortion"] = x.distortion_energy;
             e["initial"] = x.initial_energy;
             return e;
           },

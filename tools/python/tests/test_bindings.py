@@ -226,6 +226,23 @@ def test_particle_count_out_of_range(plane, cap):
         elastic.map_regions(plane.region("boundary"), cap.region("boundary"), particles=3)
     with pytest.raises(ValueError, match="curvature_radius"):
         elastic.map_regions(plane.region("boundary"), cap.region("boundary"), curvature_radius=-1)
+    with pytest.raises(ValueError, match="distortion_weight"):
+        elastic.map_regions(plane.region("boundary"), cap.region("boundary"), distortion_weight=-1)
+
+
+def test_distortion_weight_matches_the_tools_flag(plane, cap, plane_cap, tmp_path):
+    assert plane_cap.energy["distortion"] == 0.0  # off by default
+    report = tool_report("map", dict(PLANE_CAP, **{"distortion-weight": 0.25}), tmp_path)
+    m = elastic.map_regions(
+        plane.region(PLANE_CAP["source-region"]),
+        cap.region(PLANE_CAP["target-region"]),
+        particles=PLANE_CAP["particles"],
+        distortion_weight=0.25,
+        threads=2,
+    )
+    assert m.ok and m.energy["distortion"] > 0.0
+    assert m.energy["distortion"] == pytest.approx(report["energy"]["distortion"], rel=1e-12)
+    assert m.energy["length"] == pytest.approx(report["energy"]["length"], rel=1e-12)
 
 
 def test_vectors_follow_the_maps_differential(plane_cap, plane):
