@@ -261,6 +261,30 @@ TEST(Cli, ForcedFailureHasOneVerdictAcrossMapCompareAndPaste) {
   EXPECT_EQ(ok_report["folds"], 0);
 }
 
+// `bench warm` on a small drag (the command, not its figures): one cold first map, then every step
+// mapped cold and warm, the warm ones converged fold-free to the cold ones' energy (2%); a region
+// that is not a disk cannot be dragged.
+TEST(Cli, BenchWarmMapsEveryStepColdAndWarm) {
+  const fs::path dir = test::scratch_dir("cli_bench_warm");
+  const CliRun run = elastic(
+      "bench warm -q --particles 300 --steps 3 --threads 2 --report " + (dir / "w.json").string(),
+      dir);
+  ASSERT_EQ(run.code, 0) << run.err;
+  const nlohmann::json report = nlohmann::json::parse(std::ifstream(dir / "w.json"));
+  const nlohmann::json& steps = report["result"]["steps"];
+  ASSERT_EQ(steps.size(), 4u);
+  EXPECT_FALSE(steps[0].contains("warm"));
+  for (std::size_t k = 1; k < steps.size(); ++k) {
+    const nlohmann::json& warm = steps[k]["warm"];
+    EXPECT_TRUE(warm["converged"].get<bool>()) << steps[k].dump();
+    EXPECT_EQ(warm["folds"], 0);
+    EXPECT_NEAR(warm["energy"].get<double>(), steps[k]["cold"]["energy"].get<double>(),
+                0.02 * steps[k]["cold"]["energy"].get<double>());
+    EXPECT_NE(steps[k]["region"], steps[k - 1]["region"]);  // the disk did move
+  }
+  expect_error(elastic("bench warm -q --target-region boundary", dir), 65, "disk");
+}
+
 // `bench robustness` on two tiny cases (the command, not its figures): one that runs, one whose
 // region cannot be built. Every case carries a boolean `pass`; the running case's checks are
 // recomputed here from its reported figures by the documented criteria (docs/results.md).

@@ -1,5 +1,6 @@
 #include "bench_common.h"
 
+#include <algorithm>
 #include <cmath>
 #include <ctime>
 #include <filesystem>
@@ -110,6 +111,15 @@ std::string fmt_number(double v, int digits) {
   std::ostringstream o;
   o << std::setprecision(digits) << v;
   return o.str();
+}
+
+double median(std::vector<double> v) {
+  if (v.empty()) {
+    return std::numeric_limits<double>::quiet_NaN();
+  }
+  std::sort(v.begin(), v.end());
+  const size_t n = v.size();
+  return n % 2 == 1 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
 double json_number(const nlohmann::json& j, const char* key) {

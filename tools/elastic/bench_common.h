@@ -45,6 +45,8 @@ std::string missing_input(const MapJob& job);
 
 /// A figure for a results table: `digits` significant digits; "–" for NaN, "inf" / "-inf".
 std::string fmt_number(double v, int digits = 3);
+/// The median of `v` (the mean of the middle two for an even count), NaN when empty.
+double median(std::vector<double> v);
 /// j[key] as a double, NaN when absent or not a number.
 double json_number(const nlohmann::json& j, const char* key);
 

@@ -214,13 +214,6 @@ std::string decals_markdown(const nlohmann::json& report) {
                                   json_number(c["elastic"], "length_energy"));
     sd_margin[size].push_back(sd_excess(c["expmap"]) / sd_excess(c["elastic"]));
   }
-  const auto median = [](std::vector<double> v) {
-    if (v.empty()) {
-      return std::numeric_limits<double>::quiet_NaN();
-    }
-    std::sort(v.begin(), v.end());
-    return v[v.size() / 2];
-  };
   s << decals_preamble(report);
   s << "**Summary: " << passed << " of " << cases.size() << " cases pass.** Margins (median "
     << "over the cases of each size, exponential map ÷ ElasticPaint): ";

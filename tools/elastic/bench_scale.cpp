@@ -32,12 +32,6 @@ struct ScaleArgs {
   bool quiet = false;
 };
 
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  const size_t n = v.size();
-  return n % 2 == 1 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
-
 // The relaxed grid on the target as a Region (quads split along their 0-2 diagonal), for CGAL.
 Region target_grid_region(const MapSession& session) {
   const MapResult& r = session.result;

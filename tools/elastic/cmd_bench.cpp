@@ -18,6 +18,7 @@
 #include "bench_decals.h"
 #include "bench_robustness.h"
 #include "bench_scale.h"
+#include "bench_warm.h"
 #include "cli_common.h"
 #include "command.h"
 #include "compare_methods.h"
@@ -43,12 +44,6 @@ struct BenchArgs {
   bool extra = false;
   bool quiet = false;
 };
-
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  const size_t n = v.size();
-  return n % 2 == 1 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
 
 std::string fmt(double v, int digits = 4) {
   std::ostringstream o;
@@ -380,40 +375,43 @@ int run_bench(const BenchArgs& args, const CLI::App& sub) {
 }  // namespace
 }  // namespace elastic::cli
 
-ELASTIC_COMMAND("bench",
-                "Benchmarks: `bench table1` (the paper's Table 1), `bench robustness` (real "
-                "inputs), `bench scale` (speed against CGAL's LSCM), `bench decals` (placed "
-                "decals against the exponential map)",
-                [](CLI::App& sub) {
-                  auto a = std::make_shared<elastic::cli::BenchArgs>();
-                  sub.require_subcommand(1);
-                  CLI::App* table1 = sub.add_subcommand(
-                      "table1", "The paper's nine cases: ElasticPaint and the baselines");
-                  table1->add_option("--cases", a->cases, "Cases file (JSON)");
-                  table1->add_option("--root", a->root,
-                                     "Folder the cases' mesh paths are relative to");
-                  table1->add_option("--report", a->report, "Write the JSON report here");
-                  table1->add_option("--markdown", a->markdown,
-                                     "Write the Markdown results page here (default: stdout)");
-                  table1->add_option("--runs", a->runs, "Runs per case (median seconds)")
-                      ->check(CLI::Range(1, 100));
-                  table1->add_option("--threads", a->threads, "Threads of every stage (0: all)")
-                      ->check(CLI::Range(0, 1024));
-                  table1->add_option("--only", a->only, "Run only the case with this name");
-                  table1->add_flag("--extra", a->extra,
-                                   "Also run the extra cases (real meshes of ../shared/meshes)");
-                  table1->add_flag("--quiet,-q", a->quiet, "No progress lines on stderr");
-                  const std::function<int()> robustness =
-                      elastic::cli::add_robustness_subcommand(sub);
-                  CLI::App* scale_sub = nullptr;
-                  const std::function<int()> scale = elastic::cli::add_scale_subcommand(sub);
-                  scale_sub = sub.get_subcommand("scale");
-                  const std::function<int()> decals = elastic::cli::add_decals_subcommand(sub);
-                  CLI::App* decals_sub = sub.get_subcommand("decals");
-                  return [a, table1, robustness, scale, scale_sub, decals, decals_sub] {
-                    if (table1->parsed()) return elastic::cli::run_bench(*a, *table1);
-                    if (scale_sub->parsed()) return scale();
-                    if (decals_sub->parsed()) return decals();
-                    return robustness();
-                  };
-                });
+ELASTIC_COMMAND(
+    "bench",
+    "Benchmarks: `bench table1` (the paper's Table 1), `bench robustness` (real "
+    "inputs), `bench scale` (speed against CGAL's LSCM), `bench decals` (placed "
+    "decals against the exponential map), `bench warm` (warm-started maps of a "
+    "dragged region against cold ones)",
+    [](CLI::App& sub) {
+      auto a = std::make_shared<elastic::cli::BenchArgs>();
+      sub.require_subcommand(1);
+      CLI::App* table1 =
+          sub.add_subcommand("table1", "The paper's nine cases: ElasticPaint and the baselines");
+      table1->add_option("--cases", a->cases, "Cases file (JSON)");
+      table1->add_option("--root", a->root, "Folder the cases' mesh paths are relative to");
+      table1->add_option("--report", a->report, "Write the JSON report here");
+      table1->add_option("--markdown", a->markdown,
+                         "Write the Markdown results page here (default: stdout)");
+      table1->add_option("--runs", a->runs, "Runs per case (median seconds)")
+          ->check(CLI::Range(1, 100));
+      table1->add_option("--threads", a->threads, "Threads of every stage (0: all)")
+          ->check(CLI::Range(0, 1024));
+      table1->add_option("--only", a->only, "Run only the case with this name");
+      table1->add_flag("--extra", a->extra,
+                       "Also run the extra cases (real meshes of ../shared/meshes)");
+      table1->add_flag("--quiet,-q", a->quiet, "No progress lines on stderr");
+      const std::function<int()> robustness = elastic::cli::add_robustness_subcommand(sub);
+      CLI::App* scale_sub = nullptr;
+      const std::function<int()> scale = elastic::cli::add_scale_subcommand(sub);
+      scale_sub = sub.get_subcommand("scale");
+      const std::function<int()> decals = elastic::cli::add_decals_subcommand(sub);
+      CLI::App* decals_sub = sub.get_subcommand("decals");
+      const std::function<int()> warm = elastic::cli::add_warm_subcommand(sub);
+      CLI::App* warm_sub = sub.get_subcommand("warm");
+      return [a, table1, robustness, scale, scale_sub, decals, decals_sub, warm, warm_sub] {
+        if (table1->parsed()) return elastic::cli::run_bench(*a, *table1);
+        if (scale_sub->parsed()) return scale();
+        if (decals_sub->parsed()) return decals();
+        if (warm_sub->parsed()) return warm();
+        return robustness();
+      };
+    });

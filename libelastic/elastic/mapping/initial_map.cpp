@@ -296,6 +296,37 @@ InitialMap naive_map(const ParticleGrid& grid, const RegionDiskMap& source,
   return place_on_target(source_disk_points(grid, source), target);
 }
 
+InitialMap transported_map(const ParticleGrid& grid, const std::vector<SurfacePoint>& points,
+                           const std::vector<double>& boundary_parameters,
+                           const RegionDiskMap& from, const RegionDiskMap& to) {
+  const int n = grid.num_particles();
+  if (points.size() != static_cast<std::size_t>(n) ||
+      boundary_parameters.size() != grid.boundary_loop.size()) {
+    throw InvalidInputError("transported map",
+                            "the map's points or boundary parameters do not match the grid (" +
+                                std::to_string(n) + " particles)");
+  }
+  // The same two halves as the naive map, with `from`'s disk in place of the source's.
+  SourceDiskPoints disk;
+  disk.disk.assign(static_cast<std::size_t>(n), Eigen::Vector2d::Zero());
+  disk.parameter.assign(static_cast<std::size_t>(n), -1.0);
+  disk.outside.assign(static_cast<std::size_t>(n), 0);
+  for (std::size_t k = 0; k < grid.boundary_loop.size(); ++k) {
+    const double s = boundary_parameters[k] - std::floor(boundary_parameters[k]);  // periodic
+    disk.parameter[static_cast<std::size_t>(grid.boundary_loop[k])] = s;
+  }
+  tbb::parallel_for(tbb::blocked_range<int>(0, n, 512), [&](const tbb::blocked_range<int>& r) {
+    for (int i = r.begin(); i != r.end(); ++i) {
+      const auto k = static_cast<std::size_t>(i);
+      if (disk.parameter[k] < 0.0 && !from.to_disk(points[k], disk.disk[k])) {
+        disk.outside[k] = 1;
+        disk.disk[k].setZero();
+      }
+    }
+  });
+  return place_on_target(disk, to);
+}
+
 namespace {
 
 // Faces of the naive map that fold against the target surface: the one fold definition

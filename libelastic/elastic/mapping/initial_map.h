@@ -68,6 +68,19 @@ struct InitialMap {
 InitialMap naive_map(const ParticleGrid& grid, const RegionDiskMap& source,
                      const RegionDiskMap& target);
 
+/// Carries a map of `grid` from one region to another through their disk maps (a warm start:
+/// the relaxed placement on a region that then moved or changed size): each interior particle's
+/// surface point `points[i]` (on `from`'s region) goes to its disk coordinates on `from` and comes
+/// back from `to`'s disk; boundary particle k (grid.boundary_loop order) lands at
+/// `to.boundary_point(boundary_parameters[k])` (taken modulo 1). The disk maps' offsets should
+/// agree so the disk means the same turn on both. On `from` == `to` interior particles return to
+/// their points (to the disk maps' round-off). Particles not in `from`'s region land at the
+/// disk's centre and are counted in `outside`.
+/// \throws InvalidInputError when `points` or `boundary_parameters` do not match the grid.
+InitialMap transported_map(const ParticleGrid& grid, const std::vector<SurfacePoint>& points,
+                           const std::vector<double>& boundary_parameters,
+                           const RegionDiskMap& from, const RegionDiskMap& to);
+
 struct BoundaryOffsetOptions {
   /// Offsets tried: k / candidates of the boundary, k = 0 .. candidates - 1.
   int candidates = 24;

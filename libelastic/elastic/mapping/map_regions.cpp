@@ -10,17 +10,60 @@ namespace {
 double seconds_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
-}  // namespace
 
-MapResult map_regions(const SurfaceProjector& source, const Region& source_region,
-                      const SurfaceProjector& target, const Region& target_region,
-                      const MapOptions& options) {
+void check_surfaces(const SurfaceProjector& source, const Region& source_region,
+                    const SurfaceProjector& target, const Region& target_region) {
   if (source_region.surface != &source.surface()) {
     throw InvalidInputError("source region", "does not lie on the source surface");
   }
   if (target_region.surface != &target.surface()) {
     throw InvalidInputError("target region", "does not lie on the target surface");
   }
+}
+
+double region_rest_scale(RestScale mode, const Region& source_region, const Region& target_region) {
+  const RegionSizes sizes{.source_boundary_length = source_region.boundary_curve().length(),
+                          .target_boundary_length = target_region.boundary_curve().length(),
+                          .source_area = source_region.area(),
+                          .target_area = target_region.area()};
+  return rest_scale_factor(mode, sizes);
+}
+
+// The relaxation problem of `grid` on `target` from `start`, the boundary's targets being the
+// start's boundary positions.
+RelaxationProblem relaxation_problem(const ParticleGrid& grid, const SurfaceProjector& target,
+                                     const InitialMap& start, const MapResult& result,
+                                     RestScale mode) {
+  RelaxationProblem problem;
+  problem.grid = &grid;
+  problem.target = &target;
+  problem.initial_positions = start.positions;
+  problem.initial_points = start.points;
+  problem.rest_scale = result.rest_scale;
+  problem.rest_scale_mode = mode;
+  problem.boundary_targets.resize(3, static_cast<Eigen::Index>(grid.boundary_loop.size()));
+  for (size_t k = 0; k < grid.boundary_loop.size(); ++k) {
+    problem.boundary_targets.col(static_cast<Eigen::Index>(k)) =
+        start.positions.col(grid.boundary_loop[k]);
+  }
+  const RegionDiskMap* target_disk = result.target_disk.get();
+  problem.boundary_curve = [target_disk](double s) { return target_disk->boundary_point(s); };
+  return problem;
+}
+// The queryable mapping of the relaxed grid (the last stage of both entry points).
+void build_mapping(const SurfaceProjector& source, const SurfaceProjector& target,
+                   MapResult& result) {
+  const auto start = std::chrono::steady_clock::now();
+  result.mapping = Mapping(result.sampling.grid, source, *result.source_disk, target,
+                           *result.target_disk, result.relaxation.points);
+  result.seconds_mapping = seconds_since(start);
+}
+}  // namespace
+
+MapResult map_regions(const SurfaceProjector& source, const Region& source_region,
+                      const SurfaceProjector& target, const Region& target_region,
+                      const MapOptions& options) {
+  check_surfaces(source, source_region, target, target_region);
   if (options.subdivisions < 0) {
     throw InvalidInputError("subdivisions", "must be 0 or more");
   }
@@ -49,11 +92,7 @@ MapResult map_regions(const SurfaceProjector& source, const Region& source_regio
   result.target_disk = std::make_unique<RegionDiskMap>(target_region);
 
   // 3. Rest scale sigma between the two regions' sizes.
-  const RegionSizes sizes{.source_boundary_length = source_region.boundary_curve().length(),
-                          .target_boundary_length = target_region.boundary_curve().length(),
-                          .source_area = source_region.area(),
-                          .target_area = target_region.area()};
-  result.rest_scale = rest_scale_factor(options.rest_scale, sizes);
+  result.rest_scale = region_rest_scale(options.rest_scale, source_region, target_region);
 
   if (options.choose_offset && !source_region.anchor_given && !target_region.anchor_given) {
     BoundaryOffsetResult offset = choose_boundary_offset(
@@ -80,20 +119,8 @@ MapResult map_regions(const SurfaceProjector& source, const Region& source_regio
   // 4. Relaxation on the target (§4.2, §4.4-4.6). Boundary particles stay at their arc-length
   // positions.
   stage("relax");
-  RelaxationProblem problem;
-  problem.grid = &grid;
-  problem.target = &target;
-  problem.initial_positions = result.naive.positions;
-  problem.initial_points = result.naive.points;
-  problem.rest_scale = result.rest_scale;
-  problem.rest_scale_mode = options.rest_scale;
-  problem.boundary_targets.resize(3, static_cast<Eigen::Index>(grid.boundary_loop.size()));
-  for (size_t k = 0; k < grid.boundary_loop.size(); ++k) {
-    problem.boundary_targets.col(static_cast<Eigen::Index>(k)) =
-        result.naive.positions.col(grid.boundary_loop[k]);
-  }
-  const RegionDiskMap* target_disk = result.target_disk.get();
-  problem.boundary_curve = [target_disk](double s) { return target_disk->boundary_point(s); };
+  const RelaxationProblem problem =
+      relaxation_problem(grid, target, result.naive, result, options.rest_scale);
   result.relaxation = relax(problem, options.relaxation);
   result.sampled_particles = grid.num_particles();
 
@@ -123,10 +150,75 @@ MapResult map_regions(const SurfaceProjector& source, const Region& source_regio
 
   // 6. The queryable mapping.
   stage("mapping");
-  start = std::chrono::steady_clock::now();
-  result.mapping = Mapping(grid, source, *result.source_disk, target, *result.target_disk,
-                           result.relaxation.points);
-  result.seconds_mapping = seconds_since(start);
+  build_mapping(source, target, result);
+  return result;
+}
+
+MapResult map_regions(const SurfaceProjector& source, const Region& source_region,
+                      const SurfaceProjector& target, const Region& target_region,
+                      const MapResult& previous, const MapOptions& options) {
+  check_surfaces(source, source_region, target, target_region);
+  const ParticleGrid& previous_grid = previous.sampling.grid;
+  if (!previous.source_disk || !previous.target_disk || previous_grid.num_particles() == 0 ||
+      previous.relaxation.points.size() !=
+          static_cast<std::size_t>(previous_grid.num_particles())) {
+    throw InvalidInputError("previous map", "has no relaxed map to start from");
+  }
+  if (&previous.source_disk->region() != &source_region) {
+    throw InvalidInputError("previous map",
+                            "was made from another source region: a warm start keeps the source "
+                            "grid, so map a new source region without one");
+  }
+  if (previous.subdivisions > 0 || options.subdivisions != 0) {
+    throw InvalidInputError("previous map", "warm starts do not combine with subdivision yet");
+  }
+  const auto stage = [&](std::string_view name) {
+    if (!report_progress(options.progress, {.stage = name})) {
+      throw Error("map", "cancelled during " + std::string(name));
+    }
+  };
+  MapResult result;
+  result.warm_started = true;
+
+  // 1-3. The previous grid and source disk; the new target's disk map with the previous turn;
+  // the previous placement carried over.
+  stage("warm start");
+  auto start = std::chrono::steady_clock::now();
+  result.sampling = previous.sampling;
+  const ParticleGrid& grid = result.sampling.grid;
+  result.source_disk = std::make_unique<RegionDiskMap>(*previous.source_disk);
+  result.target_disk = std::make_unique<RegionDiskMap>(target_region);
+  result.target_disk->set_offset(previous.boundary_offset);
+  result.boundary_offset = previous.boundary_offset;
+  result.rest_scale = region_rest_scale(options.rest_scale, source_region, target_region);
+  std::vector<double> boundary = previous.relaxation.boundary_parameters;
+  if (options.relaxation.boundary == BoundaryMode::Fixed ||
+      boundary.size() != grid.boundary_loop.size()) {
+    boundary = grid.boundary_parameter;  // the arc-length correspondence
+  }
+  result.naive = transported_map(grid, previous.relaxation.points, boundary, *previous.target_disk,
+                                 *result.target_disk);
+  if (result.naive.outside > 0) {
+    throw NumericalError("map", std::to_string(result.naive.outside) +
+                                    " particles of the previous map could not be carried over");
+  }
+  result.seconds_naive = seconds_since(start);
+
+  // 4. Relaxation, judged against the previous start's gradient at the new rest scale (the
+  // springs' forces scale with sigma).
+  stage("relax");
+  RelaxationProblem problem =
+      relaxation_problem(grid, target, result.naive, result, options.rest_scale);
+  if (options.relaxation.boundary == BoundaryMode::Slide) {
+    problem.boundary_parameters = boundary;
+  }
+  problem.reference_gradient_norm =
+      previous.relaxation.initial_gradient_norm * result.rest_scale / previous.rest_scale;
+  result.relaxation = relax(problem, options.relaxation);
+  result.sampled_particles = grid.num_particles();
+
+  stage("mapping");
+  build_mapping(source, target, result);
   return result;
 }
 

@@ -58,8 +58,13 @@ struct MapOptions {
 struct MapResult {
   SampleRegionResult sampling;  ///< the particle grid on the source and its statistics
   /// The naive map of the grid (recomputed for the refined grid after subdivision, so it has one
-  /// entry per particle of sampling.grid; the relaxation started from the sampled grid's).
+  /// entry per particle of sampling.grid; the relaxation started from the sampled grid's). After
+  /// a warm start: the relaxation's start, the previous map carried onto the new target region
+  /// (transported_map).
   InitialMap naive;
+  /// Whether this map was warm-started from a previous one (the map_regions overload with
+  /// `previous`): then the grid is the previous one's and `seconds_sampling` is 0.
+  bool warm_started = false;
   RelaxationResult relaxation;  ///< the relaxed placement and the solver's report
   double rest_scale = 1.0;      ///< sigma actually used
   /// The turn of the boundary correspondence on the target (RegionDiskMap::set_offset), a
@@ -107,5 +112,25 @@ inline BoundaryMode auto_boundary_mode(int subdivisions) {
 MapResult map_regions(const SurfaceProjector& source, const Region& source_region,
                       const SurfaceProjector& target, const Region& target_region,
                       const MapOptions& options = {});
+
+/// Warm start: maps the same source region onto `target_region` (a region that moved, grew or
+/// shrank since `previous`, possibly on another target surface) starting from `previous`'s relaxed
+/// map instead of the naive map. The source grid, its disk map and the boundary offset are
+/// reused (no sampling, no offset search); the previous placement is carried onto the new region
+/// through the two target disk maps (transported_map), boundary particles at their previous
+/// correspondence parameters (slid ones where they slid), and relaxed with `options.relaxation`.
+/// Its stopping test is relative to `previous`'s initial gradient (scaled by the change of the
+/// rest scale; RelaxationProblem::reference_gradient_norm; a relaxation given a reference reports
+/// it as its initial gradient, so a chain of warm starts keeps the first cold map's scale): a small
+/// change of the region is judged by the problem's scale, so it takes few iterations, and an
+/// unchanged region none. `previous` must have been made from `source_region` (the same object) and
+/// its target region must still be alive; `options.sampling`, `choose_offset` and
+/// `offset_candidates` are not used. \throws InvalidInputError when `previous` has no relaxed map,
+/// was made from another source
+///         region or with subdivision, or `options.subdivisions` > 0 (not combined yet); as the
+///         cold map_regions otherwise.
+MapResult map_regions(const SurfaceProjector& source, const Region& source_region,
+                      const SurfaceProjector& target, const Region& target_region,
+                      const MapResult& previous, const MapOptions& options = {});
 
 }  // namespace elastic

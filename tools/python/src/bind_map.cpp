@@ -134,7 +134,11 @@ void measure_state(MapState& state) {
 
 std::shared_ptr<MapState> run_map(const std::shared_ptr<RegionState>& source_region,
                                   const std::shared_ptr<RegionState>& target_region,
-                                  const MapKeywords& keywords, const py::object& progress) {
+                                  const MapKeywords& keywords, const py::object& progress,
+                                  const std::shared_ptr<MapState>& previous = nullptr) {
+  if (previous && previous->decal) {
+    throw py::value_error("previous: a placed decal cannot warm-start map_regions");
+  }
   MapOptions options = map_options(keywords);
   PythonProgress listener(progress);
   options.progress = listener.callback();
@@ -145,8 +149,13 @@ std::shared_ptr<MapState> run_map(const std::shared_ptr<RegionState>& source_reg
   state->source_region = source_region;
   state->target_region = target_region;
   run_released(keywords.threads, listener, [&] {
-    state->result = map_regions(*state->source->projector, source_region->region,
-                                *state->target->projector, target_region->region, options);
+    // A warm start reads the previous map (and its target region, which it holds) only here.
+    state->result = previous
+                        ? map_regions(*state->source->projector, source_region->region,
+                                      *state->target->projector, target_region->region,
+                                      previous->result, options)
+                        : map_regions(*state->source->projector, source_region->region,
+                                      *state->target->projector, target_region->region, options);
     measure_state(*state);
   });
   return state;
@@ -475,12 +484,13 @@ void bind_map(py::module_& m) {
          const std::string& boundary, const std::string& boundary_offset,
          const std::string& preconditioner, const py::object& angular_stiffness, int subdivide,
          int threads, double jitter, unsigned long seed, long max_iterations,
-         double curvature_radius, double distortion_weight, const py::object& progress) {
+         double curvature_radius, double distortion_weight, const py::object& progress,
+         const std::shared_ptr<MapState>& previous) {
         const MapKeywords k{particles,      solver,           energy,           rest_scale,
                             boundary,       boundary_offset,  preconditioner,   angular_stiffness,
                             subdivide,      threads,          jitter,           seed,
                             max_iterations, curvature_radius, distortion_weight};
-        return run_map(source_region, target_region, k, progress);
+        return run_map(source_region, target_region, k, progress, previous);
       },
       py::arg("source_region"), py::arg("target_region"), py::kw_only(),
       py::arg("particles") = 1000, py::arg("solver") = "lbfgs", py::arg("energy") = "robust",
@@ -490,10 +500,15 @@ void bind_map(py::module_& m) {
       py::arg("jitter") = 0.0, py::arg("seed") = 0, py::arg("max_iterations") = 0,
       py::arg("curvature_radius") = AdaptiveSamplingOptions{}.curvature_radius,
       py::arg("distortion_weight") = 0.0, py::arg("progress") = py::none(),
+      py::arg("previous") = nullptr,
       "Maps source_region onto target_region (each a Region of its Surface) with the particle "
       "system: the keywords are the flags of `elastic map` (docs/cli.md) with underscores. "
       "progress: called as progress(stage, iteration, total, energy, gradient); return False to "
-      "stop. Runs without the GIL; Ctrl-C raises KeyboardInterrupt. -> Map. A map that did not "
+      "stop. Runs without the GIL; Ctrl-C raises KeyboardInterrupt. previous: a Map of the same "
+      "source_region object to warm-start from (its grid and boundary turn are kept, its relaxed "
+      "placement carried onto target_region; the sampling keywords are then not used; "
+      "docs/api.md). "
+      "-> Map. A map that did not "
       "converge or has folds is returned (check Map.ok), as `elastic map` writes its report "
       "before exiting 70.");
 

@@ -360,3 +360,18 @@ def test_place_decal_matches_the_tools_report_and_pastes(plane, cap, tmp_path):
     with pytest.raises(ValueError, match="SCALE at most"):
         elastic.place_decal(plane.region("disk:0.5,0.5,0,0.3"), cap, (0.9, 0.0, 0.3), scale=3,
                             particles=200)
+
+
+def test_warm_start_from_a_previous_map(plane, cap):
+    source = plane.region(PLANE_CAP["source-region"])
+    before = cap.region("disk:0,0,1,0.5")
+    after = cap.region("disk:0.1,0,0.995,0.52")
+    first = elastic.map_regions(source, before, particles=800, threads=2)
+    cold = elastic.map_regions(source, after, particles=800, threads=2)
+    warm = elastic.map_regions(source, after, particles=800, threads=2, previous=first)
+    assert first.ok and cold.ok and warm.ok
+    assert warm.num_particles == first.num_particles  # the previous grid, not a new sampling
+    assert warm.energy["length"] == pytest.approx(cold.energy["length"], rel=0.02)
+    # Another source region (even an equal one) cannot reuse the previous grid.
+    with pytest.raises(ValueError, match="previous map"):
+        elastic.map_regions(plane.region(PLANE_CAP["source-region"]), after, previous=first)
