@@ -103,12 +103,13 @@ TEST_P(WarmStart, MovedRegionReachesTheColdMapsEnergy) {
   EXPECT_NEAR(warm.rest_scale, cold.rest_scale, 1e-12);
 }
 
+std::string boundary_name(const ::testing::TestParamInfo<BoundaryMode>& param) {
+  return param.param == BoundaryMode::Fixed ? "Fixed" : "Slide";
+}
+
 INSTANTIATE_TEST_SUITE_P(BothBoundaries, WarmStart,
                          ::testing::Values(BoundaryMode::Fixed, BoundaryMode::Slide),
-                         [](const ::testing::TestParamInfo<BoundaryMode>& info) {
-                           return info.param == BoundaryMode::Fixed ? std::string("Fixed")
-                                                                    : std::string("Slide");
-                         });
+                         boundary_name);
 
 // A warm start keeps the source grid: another source region (even an equal one) or subdivision
 // are refused, naming the previous map.

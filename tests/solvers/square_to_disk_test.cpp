@@ -304,7 +304,11 @@ TEST(AngularStiffness, RobustDefaultKeepsLengthsBetterOnASquareIntoADisk) {
 TEST(Untangle, RobustEnergyUntanglesThenConvergesOnTheGoblet) {
   const ShapeOptions shape{.faces = ShapeFaces::Quads, .resolution = 32, .scale = 1.0};
   const NaiveProblem naive(shape, make_goblet(shape), "disk:0,0,0,0.85", 1000, true);
-  const RelaxationResult result = relax(naive.problem, RelaxationOptions{});
+  // The threshold these radii were measured with (the default became 0.42 on 2026-12-03, and
+  // then this start, too, unfolds inside the barrier run): the test is of the untangling path.
+  RelaxationOptions options;
+  options.barrier_sigma = 0.4;
+  const RelaxationResult result = relax(naive.problem, options);
   EXPECT_GT(result.initial_folded_faces, 0);
   EXPECT_EQ(result.untangle_phases, 1);
   EXPECT_TRUE(result.converged) << to_string(result.reason);

@@ -100,6 +100,12 @@ struct RegionSizes {
 /// \throws InvalidInputError when a size the mode uses is not finite and positive.
 double rest_scale_factor(RestScale mode, const RegionSizes& sizes);
 
+/// The default threshold of the injectivity barrier (SpringEnergyOptions::barrier_sigma): 0.42
+/// keeps the robustness benchmark's sharpest tips (a 36-degree star tip opened to about 180) at
+/// sigma_min >= 0.2 (0.209 onto spot's flank; 0.192 at 0.4) at a length energy still below 0.9 of
+/// the best baseline's in every case (docs/solvers.md).
+inline constexpr double kDefaultBarrierSigma = 0.42;
+
 struct SpringEnergyOptions {
   double stiffness = 1.0;          ///< C, normal springs (eq. 13)
   double angular_stiffness = 1.0;  ///< C_a, angular springs
@@ -109,7 +115,7 @@ struct SpringEnergyOptions {
   double barrier_stiffness = 0.0;
   /// The smaller stretch (divided by sigma) below which the barrier starts to act, about; in
   /// (0, 1).
-  double barrier_sigma = 0.4;
+  double barrier_sigma = kDefaultBarrierSigma;
   /// lambda of the distortion term E_sd (see the file comment), relative to C: its weight is
   /// lambda * C. 0: off. It trades length for angle fidelity (docs/solvers.md).
   double distortion_stiffness = 0.0;

@@ -174,8 +174,9 @@ struct RelaxationOptions {
   /// benchmark's bar allows; 10 let the star's tips fall to 0.19, 25 and more cost length energy
   /// (docs/solvers.md).
   double barrier_stiffness = 15.0;
-  /// Smaller stretch below which the barrier acts (SpringEnergyOptions::barrier_sigma).
-  double barrier_sigma = 0.4;
+  /// Smaller stretch below which the barrier acts (SpringEnergyOptions::barrier_sigma,
+  /// kDefaultBarrierSigma).
+  double barrier_sigma = kDefaultBarrierSigma;
   /// lambda of the distortion term relative to C (SpringEnergyOptions::distortion_stiffness);
   /// Robust only. 0 (off) by default: on the robustness benchmark 0.2 brings the two spot-back
   /// cases' symmetric Dirichlet within 1.02x of DCM's, but lifts the square and rectangle cases'
