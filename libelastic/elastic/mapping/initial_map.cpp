@@ -231,34 +231,44 @@ void RegionDiskMap::set_offset(double offset) {
 
 namespace {
 
-// The half of the naive map that does not depend on the target: each interior particle's point on
-// the source's disk, each boundary particle's correspondence parameter (-1 for interior ones).
+// The half of the naive map (or of a transported map) that does not depend on the target: each
+// interior particle's point on the source's (or the previous region's) disk, each boundary
+// particle's correspondence parameter (-1 for interior ones).
 struct SourceDiskPoints {
   std::vector<Eigen::Vector2d> disk;
   std::vector<double> parameter;
   std::vector<char> outside;  // 1: the source point is not in the source region (disk = 0)
 };
 
-SourceDiskPoints source_disk_points(const ParticleGrid& grid, const RegionDiskMap& source) {
+// Each particle of `grid` on `disk`'s disk: interior particle i at its surface point points[i]
+// (on `disk`'s region), boundary particle k (boundary_loop order) by its correspondence parameter
+// parameters[k], taken modulo 1 (exact for parameters already in [0, 1)).
+SourceDiskPoints disk_points(const ParticleGrid& grid, const std::vector<SurfacePoint>& points,
+                             const std::vector<double>& parameters, const RegionDiskMap& disk) {
   const int n = grid.num_particles();
   SourceDiskPoints result;
   result.disk.assign(static_cast<std::size_t>(n), Eigen::Vector2d::Zero());
   result.parameter.assign(static_cast<std::size_t>(n), -1.0);
   result.outside.assign(static_cast<std::size_t>(n), 0);
   for (std::size_t k = 0; k < grid.boundary_loop.size(); ++k) {
-    result.parameter[static_cast<std::size_t>(grid.boundary_loop[k])] = grid.boundary_parameter[k];
+    result.parameter[static_cast<std::size_t>(grid.boundary_loop[k])] =
+        parameters[k] - std::floor(parameters[k]);
   }
   // Each particle on its own (the disk maps are immutable): the same result on any thread count.
   tbb::parallel_for(tbb::blocked_range<int>(0, n, 512), [&](const tbb::blocked_range<int>& r) {
     for (int i = r.begin(); i != r.end(); ++i) {
       const auto k = static_cast<std::size_t>(i);
-      if (result.parameter[k] < 0.0 && !source.to_disk(grid.source_points[k], result.disk[k])) {
+      if (result.parameter[k] < 0.0 && !disk.to_disk(points[k], result.disk[k])) {
         result.outside[k] = 1;
         result.disk[k].setZero();  // keep the particle inside the target region; counted outside
       }
     }
   });
   return result;
+}
+
+SourceDiskPoints source_disk_points(const ParticleGrid& grid, const RegionDiskMap& source) {
+  return disk_points(grid, grid.source_points, grid.boundary_parameter, source);
 }
 
 // The other half: the disk points onto the target region.
@@ -307,24 +317,7 @@ InitialMap transported_map(const ParticleGrid& grid, const std::vector<SurfacePo
                                 std::to_string(n) + " particles)");
   }
   // The same two halves as the naive map, with `from`'s disk in place of the source's.
-  SourceDiskPoints disk;
-  disk.disk.assign(static_cast<std::size_t>(n), Eigen::Vector2d::Zero());
-  disk.parameter.assign(static_cast<std::size_t>(n), -1.0);
-  disk.outside.assign(static_cast<std::size_t>(n), 0);
-  for (std::size_t k = 0; k < grid.boundary_loop.size(); ++k) {
-    const double s = boundary_parameters[k] - std::floor(boundary_parameters[k]);  // periodic
-    disk.parameter[static_cast<std::size_t>(grid.boundary_loop[k])] = s;
-  }
-  tbb::parallel_for(tbb::blocked_range<int>(0, n, 512), [&](const tbb::blocked_range<int>& r) {
-    for (int i = r.begin(); i != r.end(); ++i) {
-      const auto k = static_cast<std::size_t>(i);
-      if (disk.parameter[k] < 0.0 && !from.to_disk(points[k], disk.disk[k])) {
-        disk.outside[k] = 1;
-        disk.disk[k].setZero();
-      }
-    }
-  });
-  return place_on_target(disk, to);
+  return place_on_target(disk_points(grid, points, boundary_parameters, from), to);
 }
 
 namespace {
