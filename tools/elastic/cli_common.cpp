@@ -40,8 +40,12 @@ LoadedSurface surface_from_mesh(PolygonMesh mesh, const std::string& path,
                          sanitized.warnings.end());
   LimitSurfaceOptions options;
   options.name = path;
-  if (scheme == "loop") options.scheme = SubdivisionScheme::Loop;
-  if (scheme == "catmull-clark") options.scheme = SubdivisionScheme::CatmullClark;
+  if (scheme == "loop") {
+    options.scheme = SubdivisionScheme::Loop;
+  }
+  if (scheme == "catmull-clark") {
+    options.scheme = SubdivisionScheme::CatmullClark;
+  }
   loaded.surface = std::make_shared<LimitSurface>(*loaded.mesh, options);
   loaded.projector = std::make_shared<SurfaceProjector>(*loaded.surface);
   return loaded;
@@ -53,7 +57,9 @@ namespace {
 /// count use it; a minimisation uses its relative gradient, which falls from 1 towards the
 /// tolerance roughly geometrically, so log(g) / log(tolerance) grows about linearly in time.
 double stage_fraction(const Progress& p, double gradient_tolerance) {
-  if (p.total > 0) return std::clamp(static_cast<double>(p.iteration) / p.total, 0.0, 1.0);
+  if (p.total > 0) {
+    return std::clamp(static_cast<double>(p.iteration) / p.total, 0.0, 1.0);
+  }
   if (p.gradient > 0.0 && p.gradient < 1.0) {
     return std::clamp(std::log(p.gradient) / std::log(gradient_tolerance), 0.0, 1.0);
   }
@@ -63,7 +69,9 @@ double stage_fraction(const Progress& p, double gradient_tolerance) {
 }  // namespace
 
 ProgressCallback terminal_progress(bool quiet) {
-  if (quiet || !::isatty(STDERR_FILENO)) return {};
+  if (quiet || !::isatty(STDERR_FILENO)) {
+    return {};
+  }
   using Clock = std::chrono::steady_clock;
   struct State {
     Clock::time_point start = Clock::now();
@@ -126,15 +134,19 @@ long long default_max_memory_mb() {
   const long pages = ::sysconf(_SC_PHYS_PAGES);
   const long page_size = ::sysconf(_SC_PAGESIZE);
   constexpr long long kMostDefault = 4096;
-  if (pages <= 0 || page_size <= 0) return kMostDefault;
-  const long long half = static_cast<long long>(pages) / 2 * page_size / (1024 * 1024);
+  if (pages <= 0 || page_size <= 0) {
+    return kMostDefault;
+  }
+  const long long half = static_cast<long long>(pages) / 2 * page_size / (1024LL * 1024);
   return std::clamp(half, 1LL, kMostDefault);
 }
 
 void check_memory(double bytes, const std::string& what, long long max_memory_mb) {
   const long long limit = max_memory_mb > 0 ? max_memory_mb : default_max_memory_mb();
   const double mb = bytes / (1024.0 * 1024.0);
-  if (mb <= static_cast<double>(limit)) return;
+  if (mb <= static_cast<double>(limit)) {
+    return;
+  }
   char text[256];
   std::snprintf(text, sizeof text,
                 "needs about %.0f MB of memory, more than the limit of %lld MB%s; raise it with "
@@ -147,16 +159,32 @@ void check_memory(double bytes, const std::string& what, long long max_memory_mb
   throw InvalidInputError(what, text);
 }
 
+std::string one_line(std::string text) {
+  while (!text.empty() && (text.back() == '\n' || text.back() == ' ')) {
+    text.pop_back();
+  }
+  for (size_t at = text.find('\n'); at != std::string::npos; at = text.find('\n', at)) {
+    text.replace(at, 1, "; ");
+  }
+  return text;
+}
+
 void print_warnings(const std::vector<std::string>& warnings, bool quiet) {
-  if (quiet) return;
-  for (const std::string& w : warnings) std::cerr << "elastic: warning: " << w << '\n';
+  if (quiet) {
+    return;
+  }
+  for (const std::string& w : warnings) {
+    std::cerr << "elastic: warning: " << w << '\n';
+  }
 }
 
 RegionSpec parse_region_flag(const std::string& text, const std::string& flag) {
   try {
     return parse_region_spec(text, flag);
   } catch (const InvalidInputError& e) {
-    if (e.input() == flag) throw UsageError(e.what());
+    if (e.input() == flag) {
+      throw UsageError(e.what());
+    }
     throw;
   }
 }
@@ -168,7 +196,9 @@ void require_extension(const std::string& path, const std::vector<std::string>& 
                  [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
   std::string allowed;
   for (const std::string& e : extensions) {
-    if (extension == e) return;
+    if (extension == e) {
+      return;
+    }
     allowed += (allowed.empty() ? "" : " or ") + e;
   }
   throw UsageError(flag + " " + path + ": this output is written as " + allowed +

@@ -60,6 +60,9 @@ void check_memory(double bytes, const std::string& what, long long max_memory_mb
 /// Prints warnings to stderr ("elastic: warning: ...") unless quiet.
 void print_warnings(const std::vector<std::string>& warnings, bool quiet);
 
+/// A message on one line: newlines (CLI11 puts some in) become "; ", trailing ones are dropped.
+std::string one_line(std::string text);
+
 /// Parses a region flag's spec (parse_region_spec). A malformed spec is a usage error (exit 64)
 /// naming `flag`; a `points:`/`uv:` file that is missing or malformed stays an IoError /
 /// InvalidInputError naming the file (exit 66 / 65).

@@ -11,6 +11,7 @@
 #include <optional>
 #include <string>
 
+#include "cli_common.h"
 #include "command.h"
 #include "elastic/core/atomic_file.h"
 #include "elastic/core/error.h"
@@ -42,15 +43,6 @@ void install_interrupt_handlers() {
     }
     ::sigaction(signal_number, &action, nullptr);
   }
-}
-
-/// A message on one line: newlines (CLI11 puts some in) become "; ", trailing ones are dropped.
-std::string one_line(std::string text) {
-  while (!text.empty() && (text.back() == '\n' || text.back() == ' ')) text.pop_back();
-  for (size_t at = text.find('\n'); at != std::string::npos; at = text.find('\n', at)) {
-    text.replace(at, 1, "; ");
-  }
-  return text;
 }
 
 /// The subcommand named on the command line ("map", "bench table1"), empty when none was.
@@ -97,7 +89,9 @@ int main(int argc, char** argv) {
     // Every subcommand takes a job file (`version` too: one grammar, docs/cli.md); nested
     // subcommands (e.g. `bench table1`) as well.
     add_job_option(*sub);
-    for (CLI::App* nested : sub->get_subcommands({})) add_job_option(*nested);
+    for (CLI::App* nested : sub->get_subcommands({})) {
+      add_job_option(*nested);
+    }
     sub->callback([runner, sub, &run, &chosen] {
       run = *runner;
       chosen = sub;
@@ -108,7 +102,9 @@ int main(int argc, char** argv) {
   // subcommand is required).
   if (argc > 1 && argv[1][0] != '-') {
     bool known = false;
-    for (const Command& command : command_registry()) known = known || command.name == argv[1];
+    for (const Command& command : command_registry()) {
+      known = known || command.name == argv[1];
+    }
     if (!known) {
       std::cerr << "elastic: unknown subcommand '" << argv[1] << "'" << usage_hint("") << '\n';
       return kUsage;
@@ -134,7 +130,9 @@ int main(int argc, char** argv) {
     if (chosen != nullptr) {
       // The job file belongs to the innermost subcommand given (`bench table1 --job F`).
       CLI::App* leaf = chosen;
-      while (!leaf->get_subcommands().empty()) leaf = leaf->get_subcommands().front();
+      while (!leaf->get_subcommands().empty()) {
+        leaf = leaf->get_subcommands().front();
+      }
       apply_job_file(*leaf);
       // --threads N bounds every stage of the run (sampling, naive map, solver, transfer,
       // rendering), not only the stage that reads the flag: a batch of runs side by side
