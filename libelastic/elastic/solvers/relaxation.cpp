@@ -281,7 +281,8 @@ RelaxationResult relax_fast(const RelaxationProblem& problem, const RelaxationOp
   RelaxationOptions fixed = options;
   fixed.boundary = BoundaryMode::Fixed;
   RelaxationResult result = relax_fast_energy(held, fixed);
-  if (!result.converged || result.folded_faces > 0) {
+  // (A cancelled held phase stops here: the caller asked to stop, not for another start.)
+  if (result.reason != StopReason::Cancelled && (!result.converged || result.folded_faces > 0)) {
     // The slid state did not settle (the slide stopped somewhere the interior cannot relax
     // from): the fixed boundary from the original start instead, when that converges fold-free.
     RelaxationResult plain = relax_fast_energy(problem, fixed);
