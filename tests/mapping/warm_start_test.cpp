@@ -103,6 +103,40 @@ TEST_P(WarmStart, MovedRegionReachesTheColdMapsEnergy) {
   EXPECT_NEAR(warm.rest_scale, cold.rest_scale, 1e-12);
 }
 
+// The studio's live updates: a warm start stopped by its progress callback (a time budget) returns
+// the placement reached, and a warm start from that one converges to the cold map's energy. Asked
+// once to stop, the relaxation asks no more (a sliding relaxation stopped in its held phase does not
+// start the fixed-boundary fallback from scratch): the callback refuses exactly once.
+TEST_P(WarmStart, StoppedWarmStartsChain) {
+  const DiskOntoSphere c;
+  const Region before = c.sphere_disk(0.0, 0.5), after = c.sphere_disk(0.1, 0.55);
+  const MapOptions options = c.options(GetParam());
+  const MapResult first = map_regions(c.source, c.from, c.target, before, options);
+  const MapResult full = map_regions(c.source, c.from, c.target, after, first, options);
+  ASSERT_TRUE(full.relaxation.converged) << to_string(full.relaxation.reason);
+  // Stop a few steps into the phase that converges (the held phase when sliding).
+  const long steps = full.relaxation.slide_iterations + 5;
+  ASSERT_LT(steps, full.relaxation.iterations + full.relaxation.slide_iterations);
+  long calls = 0, refusals = 0;
+  MapOptions budgeted = options;
+  budgeted.relaxation.progress = [&](const Progress&) {
+    const bool go_on = ++calls <= steps;
+    refusals += go_on ? 0 : 1;
+    return go_on;
+  };
+  const MapResult stopped = map_regions(c.source, c.from, c.target, after, first, budgeted);
+  EXPECT_EQ(stopped.relaxation.reason, StopReason::Cancelled);
+  EXPECT_FALSE(stopped.relaxation.converged);
+  EXPECT_EQ(refusals, 1);
+  const MapResult resumed = map_regions(c.source, c.from, c.target, after, stopped, options);
+  EXPECT_TRUE(resumed.relaxation.converged) << to_string(resumed.relaxation.reason);
+  EXPECT_EQ(resumed.relaxation.folded_faces, 0);
+  const auto energy = [](const RelaxationResult& r) {
+    return r.length_energy + r.angular_energy + r.barrier_energy;
+  };
+  EXPECT_NEAR(energy(resumed.relaxation), energy(full.relaxation), 0.01 * energy(full.relaxation));
+}
+
 std::string boundary_name(const ::testing::TestParamInfo<BoundaryMode>& param) {
   return param.param == BoundaryMode::Fixed ? "Fixed" : "Slide";
 }
