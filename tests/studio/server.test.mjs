@@ -90,6 +90,37 @@ test('bad input gets the message the CLI prints, and the server keeps serving', 
 
 // Bursts of 100 connections at once: a listen backlog too small for them (cpp-httplib's 5) drops
 // handshakes, which clients retry for up to two minutes; the time limit catches that hang.
+test('a drawn polygon becomes a points: region; an image loads as the source plane', async () => {
+  const ring = [];
+  for (let k = 0; k < 6; ++k) {
+    const a = (2 * Math.PI * k) / 6, r = 0.4;
+    ring.push([r * Math.cos(a), r * Math.sin(a), Math.sqrt(1 - r * r)]);
+  }
+  const polygon = await api(studio.port, '/api/region', { side: 'target', points: ring });
+  assert.equal(polygon.status, 200, JSON.stringify(polygon.json));
+  assert.match(polygon.json.spec, /^points:.*target-points-\d+\.txt$/);
+  const file = polygon.json.spec.slice('points:'.length);
+  assert.equal(fs.readFileSync(file, 'utf8').trim().split('\n').length, 6);
+  // The CLI cuts the same region from the file the studio wrote.
+  const region = cli(['region', target, polygon.json.spec, '--json']);
+  assert.equal(region.status, 0, region.stderr);
+  const area = JSON.parse(region.stdout).area;
+  assert.ok(Math.abs(area - polygon.json.area) <= 1e-9 * area, `${area} vs ${polygon.json.area}`);
+  const tooFew = await api(studio.port, '/api/region', { side: 'target', points: [[0, 0, 1], [0, 1, 0]] });
+  assert.ok(tooFew.status >= 400, JSON.stringify(tooFew.json));
+  const image = await api(studio.port, '/api/load',
+    { side: 'source', path: path.join(shared, 'meshes/pmp_logo_512.png') });
+  assert.equal(image.status, 200, JSON.stringify(image.json));
+  assert.equal(image.json.kind, 'image');
+  assert.equal(image.json.uv.length / 2, image.json.positions.length / 3);
+  const picture = await request(studio.port,
+    `/api/file?path=${encodeURIComponent(image.json.texture)}`);
+  assert.equal(picture.status, 200);
+  assert.match(picture.headers['content-type'], /image\/png/);
+  // Back to the mesh the run below maps from.
+  assert.equal((await api(studio.port, '/api/load', { side: 'source', path: source })).status, 200);
+});
+
 test('100 concurrent requests all answer, five times over', { timeout: 30000 }, async () => {
   for (let round = 0; round < 5; ++round) {
     const requests = [];

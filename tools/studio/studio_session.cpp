@@ -97,6 +97,15 @@ std::string spec_number(double x) {
   return s.str();
 }
 
+// ";anchor=X,Y,Z" for a request's "anchor" (none when absent or null).
+std::string anchor_suffix(const nlohmann::json& request, const std::string& flag) {
+  if (!request.contains("anchor") || request.at("anchor").is_null()) {
+    return {};
+  }
+  const Eigen::Vector3d a = json_point(request.at("anchor"), flag + ": anchor");
+  return ";anchor=" + spec_number(a.x()) + "," + spec_number(a.y()) + "," + spec_number(a.z());
+}
+
 }  // namespace
 
 Side parse_side(const std::string& text) {
@@ -291,11 +300,7 @@ nlohmann::json StudioSession::region(Side side, const nlohmann::json& request) {
       spec_text = request.value("spec", std::string());
     }
   }
-  if (request.contains("anchor") && !request.at("anchor").is_null()) {
-    const Eigen::Vector3d a = json_point(request.at("anchor"), flag + ": anchor");
-    spec_text +=
-        ";anchor=" + spec_number(a.x()) + "," + spec_number(a.y()) + "," + spec_number(a.z());
-  }
+  spec_text += anchor_suffix(request, flag);
   const RegionSpec spec = parse_region_spec(spec_text, flag);
   const Region region = make_region(*projector, spec, {.name = flag});
   std::vector<Eigen::Vector3d> outline;
@@ -488,15 +493,16 @@ nlohmann::json StudioSession::events(long since_version, long since_frame,
   return j;
 }
 
-nlohmann::json StudioSession::result(const std::string& baseline) {
-  std::shared_ptr<Run> fin;
-  {
-    std::lock_guard lock(mutex_);
-    fin = finished_;
-  }
-  if (!fin) {
+std::shared_ptr<StudioSession::Run> StudioSession::finished_run() const {
+  std::lock_guard lock(mutex_);
+  if (!finished_) {
     throw UsageError("no map has finished yet: run one first");
   }
+  return finished_;
+}
+
+nlohmann::json StudioSession::result(const std::string& baseline) {
+  const std::shared_ptr<Run> fin = finished_run();
   const MapSession& s = *fin->session;
   CompareOptions options;
   options.baselines.clear();
@@ -564,41 +570,22 @@ nlohmann::json StudioSession::result(const std::string& baseline) {
 }
 
 nlohmann::json StudioSession::job() const {
-  std::lock_guard lock(mutex_);
-  if (!finished_) {
-    throw UsageError("no map has finished yet: run one first");
-  }
-  return finished_->job_json;
+  return finished_run()->job_json;
 }
 
 nlohmann::json StudioSession::report() const {
-  std::lock_guard lock(mutex_);
-  if (!finished_) {
-    throw UsageError("no map has finished yet: run one first");
-  }
-  return finished_->report;
+  return finished_run()->report;
 }
 
 nlohmann::json StudioSession::resolve(const nlohmann::json& request) {
   std::lock_guard warm(warm_mutex_);
-  std::shared_ptr<Run> fin;
-  {
-    std::lock_guard lock(mutex_);
-    fin = finished_;
-  }
-  if (!fin) {
-    throw UsageError("no map has finished yet: run one first");
-  }
+  const std::shared_ptr<Run> fin = finished_run();
   const MapSession& s = *fin->session;
   if (s.decal) {
     throw UsageError("a placed decal (--target-place) is not re-solved live");
   }
   std::string spec_text = request.value("spec", std::string());
-  if (request.contains("anchor") && !request.at("anchor").is_null()) {
-    const Eigen::Vector3d a = json_point(request.at("anchor"), "--target-anchor");
-    spec_text +=
-        ";anchor=" + spec_number(a.x()) + "," + spec_number(a.y()) + "," + spec_number(a.z());
-  }
+  spec_text += anchor_suffix(request, "--target-region");
   const auto start = Clock::now();
   const RegionSpec spec = parse_region_spec(spec_text, "--target-region");
   warm_regions_.push_back(make_region(*s.target.projector, spec, {.name = "--target-region"}));

@@ -105,6 +105,8 @@ class StudioSession {
   struct Loaded;
   struct Run;
   void run_map(const std::shared_ptr<Run>& run);
+  /// The last finished run. \throws UsageError when none finished yet.
+  std::shared_ptr<Run> finished_run() const;
   /// Updates the run under the lock, bumps the version and wakes the waiting pages.
   template <class F>
   void update(F&& change);
