@@ -84,6 +84,6 @@ ELASTIC_COMMAND(
       sub.add_flag("-q,--quiet", a->quiet, "Print only the URL, not the requests that fail");
       sub.footer(
           "Example:\n  elastic studio --source ../shared/meshes/spot.obj --target "
-          "../shared/meshes/bob.obj\nprints the URL of the page; open it in a browser.");
+          "../shared/meshes/bob_tri.obj\nprints the URL of the page; open it in a browser.");
       return [a] { return elastic::cli::run_studio(*a); };
     });
