@@ -342,6 +342,9 @@ async function resolveLive(final) {
       const view = views.target;
       view.clearOverlays((c) => c.name !== 'outline');
       view.overlays.add(outlineObject(answer.outline, 0x0077cc));
+      // Redraws (another Show mode) keep the live placement; the heatmap's colours stay the cold
+      // run's until the next Run.
+      if (lastResult) lastResult.methods[0].positions = answer.positions;
       if (gridMeshes.elastic) {
         gridMeshes.elastic.geometry.setAttribute('position',
           new THREE.Float32BufferAttribute(answer.positions, 3));
