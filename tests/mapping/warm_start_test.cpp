@@ -105,8 +105,8 @@ TEST_P(WarmStart, MovedRegionReachesTheColdMapsEnergy) {
 
 // The studio's live updates: a warm start stopped by its progress callback (a time budget) returns
 // the placement reached, and a warm start from that one converges to the cold map's energy. Asked
-// once to stop, the relaxation asks no more (a sliding relaxation stopped in its held phase does not
-// start the fixed-boundary fallback from scratch): the callback refuses exactly once.
+// once to stop, the relaxation asks no more (a sliding relaxation stopped in its held phase does
+// not start the fixed-boundary fallback from scratch): the callback refuses exactly once.
 TEST_P(WarmStart, StoppedWarmStartsChain) {
   const DiskOntoSphere c;
   const Region before = c.sphere_disk(0.0, 0.5), after = c.sphere_disk(0.1, 0.55);
