@@ -233,6 +233,14 @@ MapOptions make_map_options(const MapJob& job, const ProgressCallback& progress)
   return options;
 }
 
+std::string mesh_surface_key(const std::string& path, const std::string& scheme) {
+  return "mesh|" + path + "|" + scheme;
+}
+
+std::string image_surface_key(const std::string& path, double width, const std::string& scheme) {
+  return "image|" + path + "|" + std::to_string(width) + "|" + scheme;
+}
+
 std::unique_ptr<MapSession> run_map_job(const MapJob& job, const ProgressCallback& progress,
                                         const FrameCallback& frame, long frame_interval,
                                         SurfaceCache* cache) {
@@ -256,7 +264,7 @@ std::unique_ptr<MapSession> run_map_job(const MapJob& job, const ProgressCallbac
   // A command's memory per target face (a paste's painted mesh) needs the target's face count:
   // the target's control mesh is read first and checked before any surface is built (building
   // the limit surfaces and their search structures is the expensive part of loading).
-  const std::string target_key = "mesh|" + job.target + "|" + job.scheme;
+  const std::string target_key = mesh_surface_key(job.target, job.scheme);
   std::optional<MeshReadResult> target_read;
   if (job.extra_bytes_per_target_face > 0.0) {
     size_t faces = 0;
@@ -306,10 +314,9 @@ std::unique_ptr<MapSession> run_map_job(const MapJob& job, const ProgressCallbac
   };
   s.source =
       s.image
-          ? surface("image|" + job.source_image + "|" + std::to_string(job.image_width) + "|" +
-                        job.source_region + "|" + job.scheme,
+          ? surface(image_surface_key(job.source_image, job.image_width, job.scheme),
                     [&] { return surface_from_mesh(s.image->mesh, job.source_image, job.scheme); })
-          : surface("mesh|" + job.source + "|" + job.scheme,
+          : surface(mesh_surface_key(job.source, job.scheme),
                     [&] { return load_surface(job.source, job.scheme); });
   print_warnings(s.source.warnings, job.quiet);
   s.target = surface(target_key, [&] {

@@ -112,6 +112,10 @@ MapOptions make_map_options(const MapJob& job, const ProgressCallback& progress 
 /// Loaded surfaces by file (or image) and scheme, for commands that map many jobs on the same
 /// meshes (`bench robustness`): each is read, repaired and prepared once.
 using SurfaceCache = std::map<std::string, LoadedSurface>;
+/// The cache key of a mesh file's surface, and of an image's plane (which does not depend on the
+/// image's region: the rectangle and the ellipse are cut from the same plane).
+std::string mesh_surface_key(const std::string& path, const std::string& scheme);
+std::string image_surface_key(const std::string& path, double width, const std::string& scheme);
 
 /// Validates the job, loads the surfaces and regions, and maps. Progress goes to `progress`
 /// (stage and solver iterations). \throws UsageError / InvalidInputError / IoError naming the flag

@@ -190,28 +190,21 @@ nlohmann::json StudioSession::load(Side side, const std::string& path) {
   loaded->image = side == Side::Source && (ext == ".png" || ext == ".jpg" || ext == ".jpeg" ||
                                            ext == ".bmp" || ext == ".tga");
   const MapJob defaults;
-  std::vector<std::string> keys;
+  std::string key;  // where run_map_job looks the surface up (for jobs with the default scheme)
   if (loaded->image) {
-    // The plane `elastic map --source-image` builds, under the keys run_map_job looks up.
+    // The plane `elastic map --source-image` builds.
     const ImagePlane plane =
         make_image_plane(file, {.width = defaults.image_width}, image_read_options(defaults));
     loaded->surface = surface_from_mesh(plane.mesh, loaded->path, defaults.scheme);
-    for (const char* region : {"boundary", "rectangle", "ellipse"}) {
-      keys.push_back("image|" + loaded->path + "|" + std::to_string(defaults.image_width) + "|" +
-                     region + "|" + defaults.scheme);
-    }
+    key = image_surface_key(loaded->path, defaults.image_width, defaults.scheme);
   } else {
     loaded->surface = load_surface(loaded->path, defaults.scheme);
-    keys.push_back("mesh|" + loaded->path + "|" + defaults.scheme);
+    key = mesh_surface_key(loaded->path, defaults.scheme);
   }
   const LimitTessellation& t = loaded->surface.projector->tessellation();
-  double diagonal = 0.0;
-  {
-    Eigen::AlignedBox3d box;
-    for (const Eigen::Vector3d& p : t.positions) {
-      box.extend(p);
-    }
-    diagonal = box.diagonal().norm();
+  Eigen::AlignedBox3d box;
+  for (const Eigen::Vector3d& p : t.positions) {
+    box.extend(p);
   }
   nlohmann::json answer = {{"side", side == Side::Source ? "source" : "target"},
                            {"path", loaded->path},
@@ -221,7 +214,7 @@ nlohmann::json StudioSession::load(Side side, const std::string& path) {
                            {"triangles", t.triangles.size()},
                            {"positions", flat(t.positions)},
                            {"indices", flat(t.triangles)},
-                           {"diagonal", diagonal}};
+                           {"diagonal", box.diagonal().norm()}};
   const PolygonMesh& mesh = *loaded->surface.mesh;
   for (const Material& material : mesh.materials) {
     if (!material.diffuse_texture.empty()) {
@@ -231,10 +224,6 @@ nlohmann::json StudioSession::load(Side side, const std::string& path) {
   }
   if (loaded->image) {
     // The plane is the rectangle [-w/2, w/2] x [-h/2, h/2] at z = 0 carrying the image upright.
-    Eigen::AlignedBox3d box;
-    for (const Eigen::Vector3d& p : t.positions) {
-      box.extend(p);
-    }
     std::vector<double> uv;
     uv.reserve(t.positions.size() * 2);
     for (const Eigen::Vector3d& p : t.positions) {
@@ -245,9 +234,7 @@ nlohmann::json StudioSession::load(Side side, const std::string& path) {
     answer["texture"] = loaded->path;
   }
   std::lock_guard lock(mutex_);
-  for (const std::string& key : keys) {
-    cache_[key] = loaded->surface;
-  }
+  cache_[key] = loaded->surface;
   (side == Side::Source ? source_ : target_) = std::move(loaded);
   return answer;
 }
