@@ -33,6 +33,11 @@ before(async () => {
       '--window-size=1400,800'],
   });
   page = await browser.newPage();
+  // The page's own errors go to the test's log (a failure below then says what broke).
+  page.on('pageerror', (error) => console.log(`page error: ${error.message}`));
+  page.on('console', (message) => {
+    if (message.type() === 'error') console.log(`page console: ${message.text()}`);
+  });
   await page.setViewport({ width: 1400, height: 800 });
   await page.goto(studio.url);
   await page.waitForFunction(() => window.studio && window.studio.ready, { timeout: 60000 });
@@ -112,8 +117,11 @@ test('a drag sets the radius; a run streams frames and ends with the painted map
   assert.ok(state.frames > 0, 'relaxation frames arrived');
   assert.equal(state.result.verdict.ok, true, JSON.stringify(state.result.verdict));
   assert.deepEqual(state.result.methods.map((m) => m.name), ['elastic', 'lscm']);
-  await new Promise((r) => setTimeout(r, 500));
+  // The result is drawn on the next animation frame, which a loaded machine may delay.
+  await page.waitForFunction(() => window.studio.renders > window.studio.resultDrawnAt,
+    { timeout: 60000 });
   const heat = await saturatedFraction('target');
+  console.log(`saturated pixels of the target view: ${heat.toFixed(4)} (before the run ${before.toFixed(4)})`);
   assert.ok(heat > 0.005 && heat > 4 * before, `heatmap pixels ${heat} (before ${before})`);
   await page.screenshot({ path: path.join(out, 'studio-heatmap.png') });
   await page.select('#show', 'paint');
@@ -142,7 +150,9 @@ test('the saved job repeats the run with the CLI to the same numbers', async () 
 
 test('dragging the target region re-solves live, warm-started', async () => {
   // Ctrl-drag moves the disk's centre in small steps, as a hand would; every step the page asks
-  // for a warm re-solve (the latest wins while one is running).
+  // for a warm re-solve (the latest wins while one is running). The first six steps come every
+  // 60 ms whatever the server's pace (edits pile up and merge); the last six each wait for the
+  // update they asked for, so a slow machine (the sanitized suite) still sees several.
   const { x, y } = await pixelOf('target', 0.5, 0.62);
   await page.evaluate(() => { window.studio.live = null; window.studio.liveLog = []; });
   await page.keyboard.down('Control');
@@ -150,7 +160,13 @@ test('dragging the target region re-solves live, warm-started', async () => {
   await page.mouse.down();
   for (let i = 1; i <= 12; ++i) {
     await page.mouse.move(x + 3 * i, y + i);
-    await new Promise((r) => setTimeout(r, 60));
+    if (i <= 6) {
+      await new Promise((r) => setTimeout(r, 60));
+    } else {
+      const n = await page.evaluate(() => window.studio.liveLog.length);
+      await page.waitForFunction((k) => window.studio.liveLog.length > k && !window.studio.liveBusy,
+        { timeout: 600000 }, n);
+    }
   }
   await page.mouse.up();
   await page.keyboard.up('Control');
@@ -160,7 +176,7 @@ test('dragging the target region re-solves live, warm-started', async () => {
   assert.equal(live.folds, 0);
   assert.equal(live.converged, true, live.stop);
   const updates = liveLog.filter((l) => !l.final);
-  assert.ok(updates.length >= 2, `${updates.length} live updates during the drag`);
+  assert.ok(updates.length >= 6, `${updates.length} live updates during the drag`);
   const median = (values) => values.slice().sort((a, b) => a - b)[Math.floor(values.length / 2)];
   console.log(`live updates during the drag: ${updates.length}, median page ` +
     `${median(updates.map((l) => l.page_seconds)).toFixed(3)} s (server ` +

@@ -7,10 +7,13 @@ import { OrbitControls } from 'three/addons/OrbitControls.js';
 
 const $ = (id) => document.getElementById(id);
 
-// What the browser test reads (tests/studio): the specs shown, the raw click, the run's state.
+// What the browser test reads (tests/studio): the specs shown, the raw click, the run's state,
+// how many times the views were drawn (`renders`; `resultDrawnAt` is its value when the result was
+// put in the scene, so a later draw shows it) and whether a live re-solve is pending (`liveBusy`).
 const studio = {
   ready: false, status: 'idle', lastHit: null, lastSnap: null, error: '',
   specs: { source: null, target: null }, result: null, live: null, liveLog: [], frames: 0,
+  renders: 0, resultDrawnAt: -1,
 };
 window.studio = studio;
 
@@ -324,6 +327,7 @@ async function edited(side) {
 // latest edit wins, a final solve is never dropped.
 const kLiveBudgetSeconds = 0.15;
 const live = { busy: false, again: false, final: false };
+Object.defineProperty(studio, 'liveBusy', { enumerable: true, get: () => live.busy || live.again });
 async function resolveLive(final) {
   if (live.busy) {
     live.again = true;
@@ -537,6 +541,7 @@ let lastResult = null;
 function drawResult() {
   if (!lastResult) return;
   const mode = $('show').value, result = lastResult;
+  studio.resultDrawnAt = studio.renders;
   views.target.clearOverlays((c) => c.name !== 'grid');
   baselineView.clearOverlays();
   const [elastic, baseline] = result.methods;
@@ -579,6 +584,7 @@ function animate() {
     dirty = false;
     for (const view of Object.values(views)) view.render();
     if (!$('baseline-view').classList.contains('hidden')) baselineView.render(views.target.camera);
+    studio.renders += 1;
   }
   requestAnimationFrame(animate);
 }
