@@ -33,7 +33,8 @@ Eigen::Vector3d barycentric_2d(const std::array<Eigen::Vector2d, 3>& tri,
 }
 
 std::vector<std::array<Eigen::Vector2d, 3>> tessellation_corner_uv(const LimitSurface& surface,
-                                                                   const LimitTessellation& tess) {
+                                                                   const LimitTessellation& tess,
+                                                                   const std::vector<int>& which) {
   const PolygonMesh& control = surface.control_mesh();
   const bool loop = surface.triangular_domain();
   // Boundary grid nodes of a ptex face and their limit positions, evaluated once per face that
@@ -63,14 +64,15 @@ std::vector<std::array<Eigen::Vector2d, 3>> tessellation_corner_uv(const LimitSu
     return list;
   };
 
-  std::vector<std::array<Eigen::Vector2d, 3>> out(tess.triangles.size());
-  for (size_t t = 0; t < tess.triangles.size(); ++t) {
+  std::vector<std::array<Eigen::Vector2d, 3>> out(which.size());
+  for (size_t i = 0; i < which.size(); ++i) {
+    const auto t = static_cast<size_t>(which[i]);
     const int f = tess.triangle_face[t];
     for (int k = 0; k < 3; ++k) {
       const int v = tess.triangles[t][k];
       const SurfacePoint& p = tess.points[static_cast<size_t>(v)];
       if (p.face == f) {
-        out[t][static_cast<size_t>(k)] = p.uv();
+        out[i][static_cast<size_t>(k)] = p.uv();
         continue;
       }
       // Welded from a neighbouring face: the coincident boundary node of f. Distinct nodes are a
@@ -81,12 +83,19 @@ std::vector<std::array<Eigen::Vector2d, 3>> tessellation_corner_uv(const LimitSu
         const double d = (x - tess.positions[static_cast<size_t>(v)]).squaredNorm();
         if (d < best) {
           best = d;
-          out[t][static_cast<size_t>(k)] = uv;
+          out[i][static_cast<size_t>(k)] = uv;
         }
       }
     }
   }
   return out;
+}
+
+std::vector<std::array<Eigen::Vector2d, 3>> tessellation_corner_uv(const LimitSurface& surface,
+                                                                   const LimitTessellation& tess) {
+  std::vector<int> all(tess.triangles.size());
+  std::iota(all.begin(), all.end(), 0);
+  return tessellation_corner_uv(surface, tess, all);
 }
 
 CutMesh::CutMesh(const LimitSurface& surface, const LimitTessellation& tess,

@@ -37,6 +37,10 @@ struct MeshLocation {
 /// node whose limit position coincides with the vertex.
 std::vector<std::array<Eigen::Vector2d, 3>> tessellation_corner_uv(const LimitSurface& surface,
                                                                    const LimitTessellation& tess);
+/// The same for the tessellation triangles `which` only, in that order.
+std::vector<std::array<Eigen::Vector2d, 3>> tessellation_corner_uv(const LimitSurface& surface,
+                                                                   const LimitTessellation& tess,
+                                                                   const std::vector<int>& which);
 
 /// (u, v) of barycentric coordinates in a triangle with corner (u, v) `uv`.
 inline Eigen::Vector2d interpolate(const std::array<Eigen::Vector2d, 3>& uv,

@@ -15,103 +15,101 @@
 #include "elastic/regions/cut_mesh.h"
 #include "elastic/regions/exact_geodesics.h"
 #include "elastic/regions/heat_geodesics.h"
+#include "elastic/regions/region_context.h"
+
+namespace elastic::regions_detail {
+
+RegionContext::RegionContext(const SurfaceProjector& p, const RegionOptions& o)
+    : projector(p), surface(p.surface()), tess(p.tessellation()), options(o) {
+  face_triangles.resize(static_cast<size_t>(surface.num_faces()));
+  for (size_t t = 0; t < tess.triangles.size(); ++t) {
+    face_triangles[static_cast<size_t>(tess.triangle_face[t])].push_back(static_cast<int>(t));
+  }
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
+  Eigen::Vector3d hi = -lo;
+  for (const Eigen::Vector3d& x : tess.positions) {
+    lo = lo.cwiseMin(x);
+    hi = hi.cwiseMax(x);
+  }
+  diagonal = tess.positions.empty() ? 0.0 : (hi - lo).norm();
+}
+
+const std::vector<std::array<Eigen::Vector2d, 3>>& RegionContext::corner_uv() const {
+  if (corner_uv_.empty()) {
+    corner_uv_ = tessellation_corner_uv(surface, tess);
+  }
+  return corner_uv_;
+}
+
+MeshLocation RegionContext::locate(const SurfacePoint& p) const {
+  MeshLocation best;
+  double best_min = -std::numeric_limits<double>::infinity();
+  // Before any whole-surface cut, only the point's face needs its triangles' corner (u, v).
+  const std::vector<int>& candidates = face_triangles[static_cast<size_t>(p.face)];
+  const std::vector<std::array<Eigen::Vector2d, 3>> uv =
+      corner_uv_.empty() ? tessellation_corner_uv(surface, tess, candidates)
+                         : std::vector<std::array<Eigen::Vector2d, 3>>{};
+  for (size_t i = 0; i < candidates.size(); ++i) {
+    const int t = candidates[i];
+    const Eigen::Vector3d b =
+        barycentric_2d(uv.empty() ? corner_uv_[static_cast<size_t>(t)] : uv[i], p.uv());
+    if (b.isZero()) {
+      continue;
+    }
+    if (b.minCoeff() > best_min) {
+      best_min = b.minCoeff();
+      best = MeshLocation{t, b};
+    }
+  }
+  if (best.triangle < 0) {
+    throw NumericalError(options.name, "internal: cannot locate a surface point");
+  }
+  Eigen::Vector3d b = best.bary.cwiseMax(0.0);
+  for (int k = 0; k < 3; ++k) {
+    b[k] = b[k] < 1e-9 ? 0.0 : b[k];
+  }
+  best.bary = b / b.sum();
+  return best;
+}
+
+MeshLocation RegionContext::project(
+    const Eigen::Vector3d& x, const std::string& what,
+    const std::function<std::string(const Eigen::Vector3d&)>& suggest) const {
+  if (!x.allFinite()) {
+    throw InvalidInputError(options.name, what + " is not finite");
+  }
+  const ClosestPoint cp = projector.closest(x);
+  if (cp.distance > options.max_point_distance * diagonal) {
+    std::ostringstream msg;
+    msg.precision(6);
+    const Eigen::Vector3d& q = cp.position;
+    msg << what << " (" << x.x() << ", " << x.y() << ", " << x.z() << ") is far from the surface ("
+        << cp.distance << " away, more than " << options.max_point_distance
+        << " of the bounding-box diagonal); the nearest surface point is (" << q.x() << ", "
+        << q.y() << ", " << q.z() << ")";
+    if (suggest) {
+      msg << ": try " << suggest(q);
+    }
+    throw InvalidInputError(options.name, msg.str());
+  }
+  return locate(cp.point);
+}
+
+void throw_not_disk(const std::string& name) {
+  throw InvalidInputError(name, "the region is not a disk (it holds a handle or a hole)");
+}
+
+}  // namespace elastic::regions_detail
 
 namespace elastic {
 namespace {
 
 using regions_detail::Chart;
 using regions_detail::CutMesh;
+using regions_detail::kSnap;
 using regions_detail::MeshLocation;
 using regions_detail::PatchTopology;
-
-/// Crossings and curve points closer than this (in barycentric terms of the triangle being cut) to
-/// a vertex or an edge are moved onto it, so that cutting never leaves sliver triangles.
-constexpr double kSnap = 1e-3;
-
-/// Everything make_region needs about the surface's tessellation.
-struct Context {
-  const SurfaceProjector& projector;
-  const LimitSurface& surface;
-  const LimitTessellation& tess;
-  const RegionOptions& options;
-  std::vector<std::array<Eigen::Vector2d, 3>> corner_uv;
-  std::vector<std::vector<int>> face_triangles;
-  double diagonal = 0.0;
-
-  Context(const SurfaceProjector& p, const RegionOptions& o)
-      : projector(p), surface(p.surface()), tess(p.tessellation()), options(o) {
-    corner_uv = regions_detail::tessellation_corner_uv(surface, tess);
-    face_triangles.resize(static_cast<size_t>(surface.num_faces()));
-    for (size_t t = 0; t < tess.triangles.size(); ++t) {
-      face_triangles[static_cast<size_t>(tess.triangle_face[t])].push_back(static_cast<int>(t));
-    }
-    Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
-    Eigen::Vector3d hi = -lo;
-    for (const Eigen::Vector3d& x : tess.positions) {
-      lo = lo.cwiseMin(x);
-      hi = hi.cwiseMax(x);
-    }
-    diagonal = tess.positions.empty() ? 0.0 : (hi - lo).norm();
-  }
-
-  CutMesh cut_mesh() const { return CutMesh(surface, tess, corner_uv, options.name); }
-
-  /// The tessellation triangle holding a surface point, with barycentric coordinates.
-  MeshLocation locate(const SurfacePoint& p) const {
-    MeshLocation best;
-    double best_min = -std::numeric_limits<double>::infinity();
-    for (int t : face_triangles[static_cast<size_t>(p.face)]) {
-      const Eigen::Vector3d b =
-          regions_detail::barycentric_2d(corner_uv[static_cast<size_t>(t)], p.uv());
-      if (b.isZero()) {
-        continue;
-      }
-      if (b.minCoeff() > best_min) {
-        best_min = b.minCoeff();
-        best = MeshLocation{t, b};
-      }
-    }
-    if (best.triangle < 0) {
-      throw NumericalError(options.name, "internal: cannot locate a surface point");
-    }
-    Eigen::Vector3d b = best.bary.cwiseMax(0.0);
-    for (int k = 0; k < 3; ++k) {
-      b[k] = b[k] < 1e-9 ? 0.0 : b[k];
-    }
-    best.bary = b / b.sum();
-    return best;
-  }
-
-  /// Projects a user point onto the surface; error when it is far from it. The error names the
-  /// nearest surface point, and `suggest` (when given) turns that point into a ready spec, e.g.
-  /// "disk:X,Y,Z,R", so that the user can copy it.
-  MeshLocation project(
-      const Eigen::Vector3d& x, const std::string& what,
-      const std::function<std::string(const Eigen::Vector3d&)>& suggest = {}) const {
-    if (!x.allFinite()) {
-      throw InvalidInputError(options.name, what + " is not finite");
-    }
-    const ClosestPoint cp = projector.closest(x);
-    if (cp.distance > options.max_point_distance * diagonal) {
-      std::ostringstream msg;
-      msg.precision(6);
-      const Eigen::Vector3d& q = cp.position;
-      msg << what << " (" << x.x() << ", " << x.y() << ", " << x.z()
-          << ") is far from the surface (" << cp.distance << " away, more than "
-          << options.max_point_distance << " of the bounding-box diagonal); the nearest surface "
-          << "point is (" << q.x() << ", " << q.y() << ", " << q.z() << ")";
-      if (suggest) {
-        msg << ": try " << suggest(q);
-      }
-      throw InvalidInputError(options.name, msg.str());
-    }
-    return locate(cp.point);
-  }
-};
-
-[[noreturn]] void throw_not_disk(const std::string& name) {
-  throw InvalidInputError(name, "the region is not a disk (it holds a handle or a hole)");
-}
+using Context = regions_detail::RegionContext;
 
 /// After a closed curve has been embedded: the side of it that is a disk (the smaller one by area
 /// when both are).
@@ -145,154 +143,9 @@ Region pick_disk_side(const CutMesh& cut, const std::string& name) {
     }
   }
   if (best < 0 || touching < 2) {
-    throw_not_disk(name);
+    regions_detail::throw_not_disk(name);
   }
   return regions_detail::make_region_from_patch(cut, comps[static_cast<size_t>(best)], best_topo);
-}
-
-// The tessellation's edges once each (a < b; boundary edges, which appear once, in their one
-// direction), sorted.
-std::vector<std::pair<int, int>> tessellation_edges(const Context& ctx, const CutMesh& cut) {
-  std::vector<std::pair<int, int>> edges;
-  for (const Eigen::Vector3i& t : ctx.tess.triangles) {
-    for (int k = 0; k < 3; ++k) {
-      const int a = t[k], b = t[(k + 1) % 3];
-      if (a < b) {
-        edges.emplace_back(a, b);
-      } else if (cut.edge_triangles(a, b).size() == 1) {
-        edges.emplace_back(b, a);
-      }
-    }
-  }
-  std::sort(edges.begin(), edges.end());
-  edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
-  return edges;
-}
-
-// Cuts the level set phi = 0 exactly: every edge whose ends have opposite signs is split where the
-// linear interpolant vanishes. Crossings within kSnap of an end move to that end (phi := 0 there).
-// phi gains a zero per new vertex.
-void cut_zero_level(const std::vector<std::pair<int, int>>& edges, CutMesh& cut,
-                    std::vector<double>& phi) {
-  const auto crosses = [](double pa, double pb) {
-    return (pa < 0.0 && pb > 0.0) || (pa > 0.0 && pb < 0.0);
-  };
-  std::vector<char> zero(phi.size(), 0);
-  for (const auto& [a, b] : edges) {
-    const double pa = phi[static_cast<size_t>(a)], pb = phi[static_cast<size_t>(b)];
-    if (!crosses(pa, pb)) {
-      continue;
-    }
-    const double t = pa / (pa - pb);
-    if (t < kSnap) {
-      zero[static_cast<size_t>(a)] = 1;
-    }
-    if (t > 1.0 - kSnap) {
-      zero[static_cast<size_t>(b)] = 1;
-    }
-  }
-  for (size_t i = 0; i < phi.size(); ++i) {
-    if (zero[i]) {
-      phi[i] = 0.0;
-    }
-  }
-  for (const auto& [a, b] : edges) {
-    const double pa = phi[static_cast<size_t>(a)], pb = phi[static_cast<size_t>(b)];
-    if (!crosses(pa, pb)) {
-      continue;
-    }
-    cut.split_edge(a, b, pa / (pa - pb));
-    phi.push_back(0.0);
-  }
-}
-
-// Per triangle of the cut mesh (each now on one side): inside when no corner is positive;
-// all-zero triangles, on the level set itself, go by the unsnapped field `raw`.
-std::vector<char> below_zero_level(const CutMesh& cut, const std::vector<double>& phi,
-                                   const std::vector<double>& raw) {
-  std::vector<char> inside(static_cast<size_t>(cut.num_triangles()), 0);
-  for (int t = 0; t < cut.num_triangles(); ++t) {
-    const Eigen::Vector3i& v = cut.triangles[static_cast<size_t>(t)];
-    double max_phi = -std::numeric_limits<double>::infinity(), raw_sum = 0.0;
-    for (int k = 0; k < 3; ++k) {
-      max_phi = std::max(max_phi, phi[static_cast<size_t>(v[k])]);
-      if (static_cast<size_t>(v[k]) < raw.size()) {
-        raw_sum += raw[static_cast<size_t>(v[k])];
-      }
-    }
-    inside[static_cast<size_t>(t)] = max_phi < 0.0;
-    if (max_phi == 0.0) {
-      bool any_negative = false;
-      for (int k = 0; k < 3; ++k) {
-        any_negative = any_negative || phi[static_cast<size_t>(v[k])] < 0.0;
-      }
-      inside[static_cast<size_t>(t)] = any_negative || raw_sum < 0.0;
-    }
-  }
-  return inside;
-}
-
-// The component of the sub-level set that holds the centre (the discrete field may have far-away
-// dips); refused when the disk is too small to hold a triangle of the cut there.
-int centre_component(const Context& ctx, const CutMesh& cut,
-                     const std::vector<std::vector<int>>& comps, const MeshLocation& centre,
-                     double radius) {
-  for (size_t c = 0; c < comps.size(); ++c) {
-    for (int t : comps[c]) {
-      if (cut.origin[static_cast<size_t>(t)] == centre.triangle) {
-        return static_cast<int>(c);
-      }
-    }
-  }
-  const Eigen::Vector3i& home = ctx.tess.triangles[static_cast<size_t>(centre.triangle)];
-  double edge_sum = 0.0;
-  for (int k = 0; k < 3; ++k) {
-    edge_sum += (ctx.tess.positions[static_cast<size_t>(home[(k + 1) % 3])] -
-                 ctx.tess.positions[static_cast<size_t>(home[k])])
-                    .norm();
-  }
-  throw InvalidInputError(ctx.options.name,
-                          "the disk of radius " + std::to_string(radius) +
-                              " is too small for the surface's tessellation (edges about " +
-                              std::to_string(edge_sum / 3.0) + " long at the centre)");
-}
-
-Region disk_region(const Context& ctx, const RegionSpec& spec) {
-  const std::string& name = ctx.options.name;
-  if (!(spec.radius > 0.0) || !std::isfinite(spec.radius)) {
-    throw InvalidInputError(name,
-                            "disk radius " + std::to_string(spec.radius) + " must be positive");
-  }
-  const MeshLocation centre =
-      ctx.project(spec.center, "disk centre", [&](const Eigen::Vector3d& q) {
-        std::ostringstream text;
-        text.precision(6);
-        text << "disk:" << q.x() << ',' << q.y() << ',' << q.z() << ',' << spec.radius;
-        return text.str();
-      });
-  // Vertices beyond the disk's reach get a distance of 4 R: outside, far from the level set.
-  const Eigen::VectorXd distance = regions_detail::local_geodesic_distance(
-      ctx.tess.positions, ctx.tess.triangles, centre, spec.radius, 4.0 * spec.radius, name);
-  CutMesh cut = ctx.cut_mesh();
-  // The level set phi = distance - R, cut exactly.
-  std::vector<double> phi(distance.data(), distance.data() + distance.size());
-  for (double& p : phi) {
-    p -= spec.radius;
-  }
-  const std::vector<double> raw = phi;
-  cut_zero_level(tessellation_edges(ctx, cut), cut, phi);
-  const std::vector<char> inside = below_zero_level(cut, phi, raw);
-  const auto comps = cut.components(&inside);
-  const int chosen = centre_component(ctx, cut, comps, centre, spec.radius);
-  PatchTopology topo = regions_detail::patch_topology(cut, comps[static_cast<size_t>(chosen)]);
-  if (topo.loops.empty()) {
-    throw InvalidInputError(name, "the disk of radius " + std::to_string(spec.radius) +
-                                      " covers the whole closed surface");
-  }
-  if (!topo.is_disk()) {
-    throw_not_disk(name);
-  }
-  return regions_detail::make_region_from_patch(cut, comps[static_cast<size_t>(chosen)], topo);
 }
 
 bool in_face(const CutMesh& cut, int v, int face) {
@@ -611,7 +464,7 @@ Region boundary_region(const Context& ctx) {
                                 ctx.surface.name() + " has " + std::to_string(topo.loops.size()));
   }
   if (!topo.is_disk()) {
-    throw_not_disk(ctx.options.name);
+    regions_detail::throw_not_disk(ctx.options.name);
   }
   return regions_detail::make_region_from_patch(cut, all, topo);
 }
@@ -742,7 +595,7 @@ Region make_region(const SurfaceProjector& projector, const RegionSpec& spec,
   Region region;
   switch (spec.kind) {
     case RegionSpec::Kind::Disk:
-      region = disk_region(ctx, spec);
+      region = regions_detail::disk_region(ctx, spec);
       break;
     case RegionSpec::Kind::Points:
       region = points_region(ctx, spec);
