@@ -325,7 +325,7 @@ async function edited(side) {
 // While the region is dragged each update gets a time budget (the relaxation continues from the
 // previous update's placement); when the drag ends the map converges. One request at a time; the
 // latest edit wins, a final solve is never dropped.
-const kLiveBudgetSeconds = 0.15;
+const kLiveBudgetSeconds = 0.1;
 const live = { busy: false, again: false, final: false };
 Object.defineProperty(studio, 'liveBusy', { enumerable: true, get: () => live.busy || live.again });
 async function resolveLive(final) {
