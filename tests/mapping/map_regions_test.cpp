@@ -11,6 +11,7 @@
 
 #include "elastic/core/error.h"
 #include "elastic/mesh/mesh_io.h"
+#include "elastic/metrics/map_metrics.h"
 #include "elastic/regions/region_spec.h"
 #include "elastic/shapes/procedural_shapes.h"
 #include "rigid_motion.h"
@@ -262,6 +263,76 @@ TEST(MapRegions, MappingAnswersBothWays) {
   // Outside the source disk, and outside the target disk.
   EXPECT_FALSE(result.mapping.forward(source.closest(Eigen::Vector3d(0.9, 0.9, 0)).point).inside);
   EXPECT_FALSE(result.mapping.inverse(target.closest(Eigen::Vector3d(-0.5, 0, 0)).point).inside);
+}
+
+// The distortion guard (MapOptions::distortion_guard). The procedural plane's disk onto the top of
+// spot's back (a case of the robustness benchmark): the length energy's minimum has a larger
+// symmetric Dirichlet energy than the naive map it started from (measured here by the metrics
+// module, not the guard's own E_sd), so the guard relaxes on with the distortion term, and the
+// map it returns is less distorted at a bounded cost in length.
+TEST(MapRegions, DistortionGuardRelaxesOnWhereLengthsTradedAngles) {
+  ELASTIC_REQUIRE_SHARED_MESH(spot_path, "spot.obj");
+  const LimitSurface source_surface(read_mesh(test::project_mesh("plane_quads.obj")).mesh);
+  const LimitSurface target_surface(read_mesh(spot_path).mesh);
+  const SurfaceProjector source(source_surface), target(target_surface);
+  const Region from = make_region(source, parse_region_spec("disk:0,0,0,0.8"));
+  const Region to = make_region(target, parse_region_spec("disk:0.181,0.946,-0.245,0.3"));
+  MapOptions options;
+  options.sampling.layout.particles = 1000;
+  options.distortion_guard = false;
+  const MapResult plain = map_regions(source, from, target, to, options);
+  options.distortion_guard = true;
+  const MapResult guarded = map_regions(source, from, target, to, options);
+  const auto measure = [&](const MapResult& r, const InitialMap& placement) {
+    return measure_on_target(r.sampling.grid, target_surface, r.rest_scale, placement.positions,
+                             placement.points);
+  };
+  const auto relaxed = [](const MapResult& r) {
+    return InitialMap{r.relaxation.positions, r.relaxation.points, 0};
+  };
+  ASSERT_TRUE(plain.relaxation.converged);
+  EXPECT_FALSE(plain.guard.checked);
+  const MapMetrics naive = measure(plain, plain.naive);
+  const MapMetrics before = measure(plain, relaxed(plain));
+  const MapMetrics after = measure(guarded, relaxed(guarded));
+  EXPECT_GT(before.symmetric_dirichlet, naive.symmetric_dirichlet);  // the guard's premise
+  ASSERT_TRUE(guarded.guard.checked);
+  ASSERT_TRUE(guarded.guard.taken);
+  EXPECT_GT(guarded.guard.relaxed, guarded.guard.naive);
+  EXPECT_LT(guarded.guard.guarded, guarded.guard.relaxed);
+  EXPECT_GT(guarded.guard.iterations, 0);
+  EXPECT_EQ(guarded.relaxation.iterations, plain.relaxation.iterations + guarded.guard.iterations);
+  EXPECT_TRUE(guarded.relaxation.converged);
+  EXPECT_EQ(after.folds, 0);
+  EXPECT_LT(after.symmetric_dirichlet, naive.symmetric_dirichlet);
+  EXPECT_LT(after.symmetric_dirichlet, before.symmetric_dirichlet - 0.1);
+  // The trade: more length energy than the lengths' own minimum, not much more.
+  EXPECT_GT(after.length_energy, before.length_energy);
+  EXPECT_LT(after.length_energy, 1.25 * before.length_energy);
+}
+
+// Where the relaxed map is no more distorted than its start (a flat disk onto a sphere's cap), the
+// guard measures and leaves the map exactly as it was; the paper's energy is never guarded.
+TEST(MapRegions, DistortionGuardLeavesOtherMapsAlone) {
+  const LimitSurface source_surface(make_plane({.resolution = 8}));
+  const LimitSurface target_surface(read_mesh(test::project_mesh("sphere_quads.obj")).mesh);
+  const SurfaceProjector source(source_surface), target(target_surface);
+  const Region from = make_region(source, parse_region_spec("disk:0,0,0,0.8"));
+  const Region to = make_region(target, parse_region_spec("disk:0,0,1,0.8"));
+  MapOptions options;
+  options.sampling.layout.particles = 600;
+  const MapResult guarded = map_regions(source, from, target, to, options);
+  EXPECT_TRUE(guarded.guard.checked);
+  EXPECT_FALSE(guarded.guard.taken);
+  EXPECT_EQ(guarded.guard.iterations, 0);
+  EXPECT_LT(guarded.guard.relaxed, guarded.guard.naive);
+  options.distortion_guard = false;
+  const MapResult plain = map_regions(source, from, target, to, options);
+  EXPECT_TRUE(guarded.relaxation.positions == plain.relaxation.positions);
+  options.distortion_guard = true;
+  options.relaxation.energy = EnergyKind::Paper;
+  options.relaxation.max_iterations = 50;
+  EXPECT_FALSE(map_regions(source, from, target, to, options).guard.checked);
 }
 
 }  // namespace

@@ -179,6 +179,11 @@ void add_map_flags(CLI::App& sub, MapJob& a) {
                  "for angle fidelity: 0.2 brings a flat disk on a hump within 2% of DCM's "
                  "distortion at about 7% more length energy (docs/solvers.md)")
       ->check(CLI::Range(0.0, 100.0));
+  sub.add_option("--distortion-guard", a.distortion_guard,
+                 "on (default): when the relaxed map's symmetric Dirichlet distortion is above its "
+                 "naive start's, relax on with --distortion-weight 0.2 (--energy robust with no "
+                 "--distortion-weight only; the report's distortion_guard says what it did); off")
+      ->check(CLI::IsMember({"on", "off"}));
   sub.add_option("--scheme", a.scheme, "Subdivision scheme for both meshes")
       ->check(CLI::IsMember({"auto", "loop", "catmull-clark"}));
   sub.add_option("--subdivide", a.subdivide,
@@ -227,6 +232,7 @@ MapOptions make_map_options(const MapJob& job, const ProgressCallback& progress)
     options.relaxation.angular_stiffness = std::stod(job.angular_stiffness);  // checked: 0..100
   }
   options.relaxation.distortion_stiffness = job.distortion_weight;
+  options.distortion_guard = job.distortion_guard == "on";
   options.subdivisions = job.subdivide;
   options.progress = progress;
   options.relaxation.progress = progress;
@@ -425,6 +431,13 @@ nlohmann::json map_report(const MapJob& job, const MapSession& session,
       {"verdict", judge_map(job, session).to_json()},
       {"held_particles", x.held_particles.size()},
       {"untangle", {{"steps", x.untangle_steps}, {"taken", x.untangled}}},
+      {"distortion_guard",
+       {{"checked", r.guard.checked},
+        {"taken", r.guard.taken},
+        {"naive", r.guard.naive},
+        {"relaxed", r.guard.relaxed},
+        {"guarded", r.guard.guarded},
+        {"iterations", r.guard.iterations}}},
       {"boundary_residual", x.boundary_residual},
       {"rest_scale", {{"mode", job.rest_scale}, {"factor", r.rest_scale}}},
       {"boundary",

@@ -45,6 +45,7 @@ struct MapJob {
   std::string energy = "robust";             ///< --energy robust|paper
   std::string angular_stiffness = "auto";    ///< --angular-stiffness auto|C_a / C
   double distortion_weight = 0.0;            ///< --distortion-weight lambda / C (robust energy)
+  std::string distortion_guard = "on";       ///< --distortion-guard on|off
   std::string boundary_offset = "auto";      ///< --boundary-offset auto|anchor
   std::string boundary = "auto";             ///< --boundary auto|fixed|slide
   std::string scheme = "auto";               ///< --scheme auto|loop|catmull-clark

@@ -50,6 +50,51 @@ RelaxationProblem relaxation_problem(const ParticleGrid& grid, const SurfaceProj
   problem.boundary_curve = [target_disk](double s) { return target_disk->boundary_point(s); };
   return problem;
 }
+// The distortion guard (MapOptions::distortion_guard): when the relaxed map's symmetric Dirichlet
+// excess E_sd (particles/spring_energy.h, lambda = 1) is above its naive start's, the length
+// energy's minimum traded angles for lengths (a flat disk onto a hump); the relaxation then goes on
+// from there with the distortion term at kGuardDistortionStiffness and is taken when it converges
+// fold-free.
+void guard_distortion(const ParticleGrid& grid, const MapOptions& options,
+                      const RelaxationProblem& problem, MapResult& result) {
+  const RelaxationOptions& relaxation = options.relaxation;
+  if (!options.distortion_guard || relaxation.energy != EnergyKind::Robust ||
+      relaxation.distortion_stiffness > 0.0 || !result.relaxation.converged ||
+      result.relaxation.folded_faces > 0) {
+    return;
+  }
+  const SpringEnergyOptions measure{
+      .stiffness = 1.0, .rest_scale = result.rest_scale, .distortion_stiffness = 1.0};
+  result.guard.relaxed = spring_energy(grid, result.relaxation.positions, measure).distortion;
+  result.guard.naive = spring_energy(grid, result.naive.positions, measure).distortion;
+  result.guard.checked = true;
+  if (!(result.guard.relaxed > options.distortion_guard_ratio * result.guard.naive)) {
+    return;
+  }
+  RelaxationProblem again = problem;
+  again.initial_positions = result.relaxation.positions;
+  again.initial_points = result.relaxation.points;
+  if (relaxation.boundary == BoundaryMode::Slide) {
+    again.boundary_parameters = result.relaxation.boundary_parameters;
+  }
+  again.reference_gradient_norm = result.relaxation.initial_gradient_norm;
+  RelaxationOptions with_term = relaxation;
+  with_term.distortion_stiffness = kGuardDistortionStiffness;
+  RelaxationResult guarded = relax(again, with_term);
+  result.guard.iterations = guarded.iterations;
+  if (!guarded.converged || guarded.folded_faces > 0) {
+    return;
+  }
+  result.guard.taken = true;
+  result.guard.guarded = spring_energy(grid, guarded.positions, measure).distortion;
+  guarded.iterations += result.relaxation.iterations;
+  guarded.setup_seconds += result.relaxation.setup_seconds;
+  guarded.solve_seconds += result.relaxation.solve_seconds;
+  guarded.initial_energy = result.relaxation.initial_energy;
+  guarded.initial_folded_faces = result.relaxation.initial_folded_faces;
+  result.relaxation = std::move(guarded);
+}
+
 // The queryable mapping of the relaxed grid (the last stage of both entry points).
 void build_mapping(const SurfaceProjector& source, const SurfaceProjector& target,
                    MapResult& result) {
@@ -123,6 +168,7 @@ MapResult map_regions(const SurfaceProjector& source, const Region& source_regio
       relaxation_problem(grid, target, result.naive, result, options.rest_scale);
   result.relaxation = relax(problem, options.relaxation);
   result.sampled_particles = grid.num_particles();
+  guard_distortion(grid, options, problem, result);
 
   // 5. Subdivision (end of §4.3): refine the grid on the source and the map on the target, relax
   // briefly after each level. Everything returned then describes the refined grid.
@@ -216,6 +262,7 @@ MapResult map_regions(const SurfaceProjector& source, const Region& source_regio
       previous.relaxation.initial_gradient_norm * result.rest_scale / previous.rest_scale;
   result.relaxation = relax(problem, options.relaxation);
   result.sampled_particles = grid.num_particles();
+  // No distortion guard: its yardstick is the naive map, and this start is a relaxed map already.
 
   stage("mapping");
   build_mapping(source, target, result);

@@ -47,9 +47,30 @@ struct MapOptions {
   /// L-BFGS iteration budget of each level's brief relaxation (fast solver; the other fields of
   /// `relaxation` are used as given).
   long subdivision_iterations = 200;
+  /// The distortion guard (robust energy without a distortion term only): when the relaxed map's
+  /// symmetric Dirichlet excess is above `distortion_guard_ratio` times its naive start's, the
+  /// relaxation continues with the distortion term at kGuardDistortionStiffness (MapResult::guard).
+  /// Cold maps only: a warm start's start is a relaxed map, not the naive one the guard compares
+  /// against.
+  bool distortion_guard = true;
+  double distortion_guard_ratio = 1.0;
   /// Called between stages ("sample", "naive map", "relax", "subdivide", "relax refined",
   /// "mapping"); return false to cancel.
   ProgressCallback progress;
+};
+
+/// The distortion term's weight (RelaxationOptions::distortion_stiffness) of the guard's second
+/// relaxation.
+inline constexpr double kGuardDistortionStiffness = 0.2;
+
+/// What the distortion guard found (MapOptions::distortion_guard).
+struct DistortionGuard {
+  bool checked = false;  ///< the guard measured the map (robust energy, converged, fold-free)
+  bool taken = false;    ///< the second relaxation ran, converged fold-free and was taken
+  double naive = 0.0;    ///< E_sd (lambda 1) of the naive start
+  double relaxed = 0.0;  ///< ... of the relaxed map
+  double guarded = 0.0;  ///< ... of the guarded map (when taken)
+  long iterations = 0;   ///< the second relaxation's iterations (0 when it did not run)
 };
 
 /// With `subdivisions` > 0, `sampling.grid` (and `sampling.statistics`), `naive`, `relaxation` and
@@ -66,6 +87,7 @@ struct MapResult {
   /// `previous`): then the grid is the previous one's and `seconds_sampling` is 0.
   bool warm_started = false;
   RelaxationResult relaxation;  ///< the relaxed placement and the solver's report
+  DistortionGuard guard;        ///< what the distortion guard found and did
   double rest_scale = 1.0;      ///< sigma actually used
   /// The turn of the boundary correspondence on the target (RegionDiskMap::set_offset), a
   /// fraction of the boundary: 0 unless chosen (MapOptions::choose_offset).

@@ -180,7 +180,8 @@ struct RelaxationOptions {
   /// lambda of the distortion term relative to C (SpringEnergyOptions::distortion_stiffness);
   /// Robust only. 0 (off) by default: on the robustness benchmark 0.2 brings the two spot-back
   /// cases' symmetric Dirichlet within 1.02x of DCM's, but lifts the square and rectangle cases'
-  /// length energy past 0.9x the best baseline's (docs/solvers.md).
+  /// length energy past 0.9x the best baseline's (docs/solvers.md). map_regions' distortion
+  /// guard (MapOptions::distortion_guard) turns it on where it is needed.
   double distortion_stiffness = 0.0;
   double stiffness = 1.0;  ///< C of the normal springs (eq. 13)
   /// C_a of the angular springs; empty: the energy's default (kPaperAngularStiffness or

@@ -43,6 +43,7 @@ struct MapKeywords {
   long max_iterations = 0;
   double curvature_radius = AdaptiveSamplingOptions{}.curvature_radius;
   double distortion_weight = 0.0;
+  bool distortion_guard = true;
 };
 
 // The MapOptions of `elastic map` for the same flags (tools/elastic/map_job.cpp).
@@ -101,6 +102,7 @@ MapOptions map_options(const MapKeywords& k) {
                           std::to_string(k.distortion_weight));
   }
   options.relaxation.distortion_stiffness = k.distortion_weight;
+  options.distortion_guard = k.distortion_guard;
   options.subdivisions = k.subdivide;
   return options;
 }
@@ -484,12 +486,24 @@ void bind_map(py::module_& m) {
          const std::string& boundary, const std::string& boundary_offset,
          const std::string& preconditioner, const py::object& angular_stiffness, int subdivide,
          int threads, double jitter, unsigned long seed, long max_iterations,
-         double curvature_radius, double distortion_weight, const py::object& progress,
-         const std::shared_ptr<MapState>& previous) {
-        const MapKeywords k{particles,      solver,           energy,           rest_scale,
-                            boundary,       boundary_offset,  preconditioner,   angular_stiffness,
-                            subdivide,      threads,          jitter,           seed,
-                            max_iterations, curvature_radius, distortion_weight};
+         double curvature_radius, double distortion_weight, bool distortion_guard,
+         const py::object& progress, const std::shared_ptr<MapState>& previous) {
+        const MapKeywords k{particles,
+                            solver,
+                            energy,
+                            rest_scale,
+                            boundary,
+                            boundary_offset,
+                            preconditioner,
+                            angular_stiffness,
+                            subdivide,
+                            threads,
+                            jitter,
+                            seed,
+                            max_iterations,
+                            curvature_radius,
+                            distortion_weight,
+                            distortion_guard};
         return run_map(source_region, target_region, k, progress, previous);
       },
       py::arg("source_region"), py::arg("target_region"), py::kw_only(),
@@ -499,8 +513,8 @@ void bind_map(py::module_& m) {
       py::arg("angular_stiffness") = py::none(), py::arg("subdivide") = 0, py::arg("threads") = 0,
       py::arg("jitter") = 0.0, py::arg("seed") = 0, py::arg("max_iterations") = 0,
       py::arg("curvature_radius") = AdaptiveSamplingOptions{}.curvature_radius,
-      py::arg("distortion_weight") = 0.0, py::arg("progress") = py::none(),
-      py::arg("previous") = nullptr,
+      py::arg("distortion_weight") = 0.0, py::arg("distortion_guard") = true,
+      py::arg("progress") = py::none(), py::arg("previous") = nullptr,
       "Maps source_region onto target_region (each a Region of its Surface) with the particle "
       "system: the keywords are the flags of `elastic map` (docs/cli.md) with underscores. "
       "progress: called as progress(stage, iteration, total, energy, gradient); return False to "
