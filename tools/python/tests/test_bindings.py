@@ -245,6 +245,26 @@ def test_distortion_weight_matches_the_tools_flag(plane, cap, plane_cap, tmp_pat
     assert m.energy["length"] == pytest.approx(report["energy"]["length"], rel=1e-12)
 
 
+def test_distortion_guard_matches_the_tools_flag(plane, tmp_path):
+    # A flat disk onto the top of spot's back: the guard acts (docs/solvers.md); off, it does not.
+    job = {"source": str(MESHES / "grid.off"), "source-region": "disk:0.5,0.5,0,0.45",
+           "target": str(MESHES / "spot.obj"), "target-region": "disk:0.181,0.946,-0.245,0.3",
+           "particles": 1000}
+    spot = elastic.Surface(job["target"])
+    lengths = {}
+    for guard in (True, False):
+        report = tool_report("map", dict(job, **{"distortion-guard": "on" if guard else "off"}),
+                             tmp_path)
+        m = elastic.map_regions(plane.region(job["source-region"]),
+                                spot.region(job["target-region"]), particles=job["particles"],
+                                distortion_guard=guard, threads=2)
+        assert m.ok
+        assert report["distortion_guard"]["taken"] is guard
+        assert m.energy["length"] == pytest.approx(report["energy"]["length"], rel=1e-12)
+        lengths[guard] = m.energy["length"]
+    assert lengths[True] > lengths[False]  # the guard trades length for less distortion
+
+
 def test_vectors_follow_the_maps_differential(plane_cap, plane):
     rng = np.random.default_rng(11)
     angle = rng.uniform(0, 2 * np.pi, 40)
