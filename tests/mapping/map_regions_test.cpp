@@ -20,6 +20,21 @@
 namespace elastic {
 namespace {
 
+// Two surfaces, their projectors and a region on each (specs as `elastic map` takes them).
+struct TwoRegions {
+  LimitSurface source_surface, target_surface;
+  SurfaceProjector source, target;
+  Region from, to;
+  TwoRegions(const PolygonMesh& source_mesh, const PolygonMesh& target_mesh,
+             const std::string& from_spec, const std::string& to_spec)
+      : source_surface(source_mesh),
+        target_surface(target_mesh),
+        source(source_surface),
+        target(target_surface),
+        from(make_region(source, parse_region_spec(from_spec))),
+        to(make_region(target, parse_region_spec(to_spec))) {}
+};
+
 // A disk on a plane mapped onto the same disk on a rigidly moved copy of the plane: the map must be
 // the rigid motion (the zero of the length and angle energies; congruent regions, congruent
 // anchors).
@@ -234,14 +249,13 @@ TEST(MapRegions, OffsetPrefersAFoldFreeNaiveMap) {
 // triangle; they differ only by the magnet's step off the particles' chord planes on the cylinder,
 // see mapping_test.cpp for the bound), and points outside the region answer "outside".
 TEST(MapRegions, MappingAnswersBothWays) {
-  const LimitSurface source_surface(make_plane({.resolution = 8}));
-  const LimitSurface target_surface(make_cylinder({.resolution = 24}));
-  const SurfaceProjector source(source_surface), target(target_surface);
-  const Region from = make_region(source, parse_region_spec("disk:0,0,0,0.5"));
-  const Region to = make_region(target, parse_region_spec("disk:0.5,0,0,0.5"));
+  const TwoRegions c(make_plane({.resolution = 8}), make_cylinder({.resolution = 24}),
+                     "disk:0,0,0,0.5", "disk:0.5,0,0,0.5");
+  const SurfaceProjector &source = c.source, &target = c.target;
+  const LimitSurface& target_surface = c.target_surface;
   MapOptions options;
   options.sampling.layout.particles = 800;
-  const MapResult result = map_regions(source, from, target, to, options);
+  const MapResult result = map_regions(source, c.from, target, c.to, options);
   ASSERT_TRUE(result.relaxation.converged);
   const double spacing = result.sampling.statistics.spacing_median;
 
@@ -272,19 +286,16 @@ TEST(MapRegions, MappingAnswersBothWays) {
 // map it returns is less distorted at a bounded cost in length.
 TEST(MapRegions, DistortionGuardRelaxesOnWhereLengthsTradedAngles) {
   ELASTIC_REQUIRE_SHARED_MESH(spot_path, "spot.obj");
-  const LimitSurface source_surface(read_mesh(test::project_mesh("plane_quads.obj")).mesh);
-  const LimitSurface target_surface(read_mesh(spot_path).mesh);
-  const SurfaceProjector source(source_surface), target(target_surface);
-  const Region from = make_region(source, parse_region_spec("disk:0,0,0,0.8"));
-  const Region to = make_region(target, parse_region_spec("disk:0.181,0.946,-0.245,0.3"));
+  const TwoRegions c(read_mesh(test::project_mesh("plane_quads.obj")).mesh,
+                     read_mesh(spot_path).mesh, "disk:0,0,0,0.8", "disk:0.181,0.946,-0.245,0.3");
   MapOptions options;
   options.sampling.layout.particles = 1000;
   options.distortion_guard = false;
-  const MapResult plain = map_regions(source, from, target, to, options);
+  const MapResult plain = map_regions(c.source, c.from, c.target, c.to, options);
   options.distortion_guard = true;
-  const MapResult guarded = map_regions(source, from, target, to, options);
+  const MapResult guarded = map_regions(c.source, c.from, c.target, c.to, options);
   const auto measure = [&](const MapResult& r, const InitialMap& placement) {
-    return measure_on_target(r.sampling.grid, target_surface, r.rest_scale, placement.positions,
+    return measure_on_target(r.sampling.grid, c.target_surface, r.rest_scale, placement.positions,
                              placement.points);
   };
   const auto relaxed = [](const MapResult& r) {
@@ -314,25 +325,23 @@ TEST(MapRegions, DistortionGuardRelaxesOnWhereLengthsTradedAngles) {
 // Where the relaxed map is no more distorted than its start (a flat disk onto a sphere's cap), the
 // guard measures and leaves the map exactly as it was; the paper's energy is never guarded.
 TEST(MapRegions, DistortionGuardLeavesOtherMapsAlone) {
-  const LimitSurface source_surface(make_plane({.resolution = 8}));
-  const LimitSurface target_surface(read_mesh(test::project_mesh("sphere_quads.obj")).mesh);
-  const SurfaceProjector source(source_surface), target(target_surface);
-  const Region from = make_region(source, parse_region_spec("disk:0,0,0,0.8"));
-  const Region to = make_region(target, parse_region_spec("disk:0,0,1,0.8"));
+  const TwoRegions c(make_plane({.resolution = 8}),
+                     read_mesh(test::project_mesh("sphere_quads.obj")).mesh, "disk:0,0,0,0.8",
+                     "disk:0,0,1,0.8");
   MapOptions options;
   options.sampling.layout.particles = 600;
-  const MapResult guarded = map_regions(source, from, target, to, options);
+  const MapResult guarded = map_regions(c.source, c.from, c.target, c.to, options);
   EXPECT_TRUE(guarded.guard.checked);
   EXPECT_FALSE(guarded.guard.taken);
   EXPECT_EQ(guarded.guard.iterations, 0);
   EXPECT_LT(guarded.guard.relaxed, guarded.guard.naive);
   options.distortion_guard = false;
-  const MapResult plain = map_regions(source, from, target, to, options);
+  const MapResult plain = map_regions(c.source, c.from, c.target, c.to, options);
   EXPECT_TRUE(guarded.relaxation.positions == plain.relaxation.positions);
   options.distortion_guard = true;
   options.relaxation.energy = EnergyKind::Paper;
   options.relaxation.max_iterations = 50;
-  EXPECT_FALSE(map_regions(source, from, target, to, options).guard.checked);
+  EXPECT_FALSE(map_regions(c.source, c.from, c.target, c.to, options).guard.checked);
 }
 
 }  // namespace

@@ -15,26 +15,15 @@
 #include <numbers>
 
 #include "elastic/mapping/map_regions.h"
-#include "elastic/mesh/mesh_io.h"
-#include "elastic/mesh/mesh_validation.h"
 #include "elastic/projection/closest_point.h"
 #include "elastic/regions/region_spec.h"
-#include "elastic/surface/limit_surface.h"
+#include "loaded_surface.h"
 
 namespace {
 
 using namespace elastic;
 
-struct Loaded {
-  PolygonMesh mesh;
-  std::unique_ptr<LimitSurface> surface;
-  std::unique_ptr<SurfaceProjector> projector;
-  explicit Loaded(const std::string& path) : mesh(read_mesh(path).mesh) {
-    sanitize_mesh(mesh, path);
-    surface = std::make_unique<LimitSurface>(mesh);
-    projector = std::make_unique<SurfaceProjector>(*surface);
-  }
-};
+using Loaded = bench::LoadedSurface;
 
 /// The benchmark's source points: a Vogel spiral of n points in the disk of radius 0.44 about
 /// (0.5, 0.5, 0) (the golden angle between consecutive points, radius 0.44 sqrt((i + 0.5) / n)).

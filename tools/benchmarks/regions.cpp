@@ -9,26 +9,15 @@
 #include <memory>
 #include <sstream>
 
-#include "elastic/mesh/mesh_io.h"
-#include "elastic/mesh/mesh_validation.h"
 #include "elastic/projection/closest_point.h"
 #include "elastic/regions/region_spec.h"
-#include "elastic/surface/limit_surface.h"
+#include "loaded_surface.h"
 
 namespace {
 
 using namespace elastic;
 
-struct Loaded {
-  PolygonMesh mesh;
-  std::unique_ptr<LimitSurface> surface;
-  std::unique_ptr<SurfaceProjector> projector;
-  explicit Loaded(const std::string& path) : mesh(read_mesh(path).mesh) {
-    sanitize_mesh(mesh, path);
-    surface = std::make_unique<LimitSurface>(mesh);
-    projector = std::make_unique<SurfaceProjector>(*surface);
-  }
-};
+using Loaded = bench::LoadedSurface;
 
 const Loaded& bob() {
   static const Loaded loaded(ELASTIC_SHARED_MESHES_DIR "/bob_tri.obj");
