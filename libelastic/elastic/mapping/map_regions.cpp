@@ -65,8 +65,9 @@ void guard_distortion(const ParticleGrid& grid, const MapOptions& options,
   }
   const SpringEnergyOptions measure{
       .stiffness = 1.0, .rest_scale = result.rest_scale, .distortion_stiffness = 1.0};
-  result.guard.relaxed = spring_energy(grid, result.relaxation.positions, measure).distortion;
-  result.guard.naive = spring_energy(grid, result.naive.positions, measure).distortion;
+  const SpringSystem springs(grid, measure);  // built once, evaluated up to three times
+  result.guard.relaxed = springs.evaluate(result.relaxation.positions).distortion;
+  result.guard.naive = springs.evaluate(result.naive.positions).distortion;
   result.guard.checked = true;
   if (!(result.guard.relaxed > options.distortion_guard_ratio * result.guard.naive)) {
     return;
@@ -86,7 +87,7 @@ void guard_distortion(const ParticleGrid& grid, const MapOptions& options,
     return;
   }
   result.guard.taken = true;
-  result.guard.guarded = spring_energy(grid, guarded.positions, measure).distortion;
+  result.guard.guarded = springs.evaluate(guarded.positions).distortion;
   guarded.iterations += result.relaxation.iterations;
   guarded.setup_seconds += result.relaxation.setup_seconds;
   guarded.solve_seconds += result.relaxation.solve_seconds;
