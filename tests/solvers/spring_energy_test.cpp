@@ -11,6 +11,7 @@
 #include <utility>
 
 #include "elastic/core/error.h"
+#include "elastic/particles/face_folds.h"
 #include "solvers/solver_fixtures.h"
 
 namespace elastic {
@@ -163,7 +164,8 @@ void lift_off_the_plane(unsigned seed, Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& no
   }
 }
 
-// With normals the barrier sees each triangle's area along its apex normal: on a plane with the
+// With normals the barrier sees each triangle's area along its corners' summed normal: on a plane
+// with the
 // plane's normal it is the 3D barrier exactly; off the plane (normals tilted, heights random) its
 // gradients match central differences (expect_triangle_gradients); a triangle that stands up from
 // the surface (its plane containing the normal) has a finite 3D barrier but is infinite as seen.
@@ -199,6 +201,56 @@ TEST(SpringEnergy, BarrierSeenAlongTheNormals) {
   up.row(2).setOnes();
   EXPECT_TRUE(std::isfinite(system.evaluate(standing).barrier));
   EXPECT_TRUE(std::isinf(system.evaluate(standing, nullptr, &up).barrier));
+}
+
+// One fold test for the solver and the report (face_folds.h): with corner normals that turn by
+// up to about 150 degrees within a face (a grid quad wrapping a sharp ridge), the solver's guard
+// (folded_faces), the report's count (inverted_faces) and the barrier (infinite exactly where a
+// triangle is inverted) agree on every configuration. The test of each corner against its own
+// normal, which the solver used until 2026-12-04, disagrees with the report on some of them.
+TEST(SpringEnergy, SolverGuardBarrierAndReportShareOneFoldTest) {
+  const ParticleGrid grid = test::make_quad_grid(4, 3, 1.0);
+  SpringSystem system(grid, barrier_test_options(true));
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> tilt(-2.0, 2.0);
+  int folded_configurations = 0, own_normal_disagrees = 0;
+  for (int trial = 0; trial < 200; ++trial) {
+    const Eigen::Matrix3Xd x =
+        random_configuration(grid, 0.45, 1000U + static_cast<unsigned>(trial));
+    Eigen::Matrix3Xd normals(3, x.cols());
+    for (Eigen::Index p = 0; p < x.cols(); ++p) {
+      normals.col(p) = Eigen::Vector3d(tilt(rng), tilt(rng), 1.0).normalized();
+    }
+    const int report = inverted_faces(grid, x, normals);
+    EXPECT_EQ(system.folded_faces(x, normals), report) << "trial " << trial;
+    Eigen::Matrix3Xd everywhere = Eigen::Matrix3Xd::Zero(3, x.cols());
+    everywhere.row(2).setOnes();
+    system.set_barrier_mask(x, everywhere);  // the barrier over the triangles unfolded along +z
+    const double barrier = system.evaluate(x, nullptr, &normals).barrier;
+    bool inverted_in_barrier = false;
+    int own_normal = 0, last_face = -1;
+    for (const SpringSystem::Corner& c : system.corners()) {
+      const bool inverted =
+          triangle_inverted(x.col(c.i), x.col(c.next), x.col(c.prev), normals.col(c.i),
+                            normals.col(c.next), normals.col(c.prev));
+      const bool up = (x.col(c.next) - x.col(c.i)).cross(x.col(c.prev) - x.col(c.i)).z() > 0.0;
+      inverted_in_barrier = inverted_in_barrier || (inverted && up);
+      const bool own =
+          !((x.col(c.next) - x.col(c.i)).cross(x.col(c.prev) - x.col(c.i)).dot(normals.col(c.i)) >
+            0.0);
+      if (own && c.face != last_face) {
+        ++own_normal;
+        last_face = c.face;
+      }
+    }
+    EXPECT_EQ(std::isinf(barrier), inverted_in_barrier) << "trial " << trial;
+    folded_configurations += report > 0 ? 1 : 0;
+    own_normal_disagrees += own_normal != report ? 1 : 0;
+  }
+  // The configurations are varied enough for the test to tell the two definitions apart.
+  EXPECT_GT(folded_configurations, 20);
+  EXPECT_LT(folded_configurations, 200);
+  EXPECT_GT(own_normal_disagrees, 10);
 }
 
 // A uniform compression of the whole grid by c (every triangle's stretches are c, c): each barrier

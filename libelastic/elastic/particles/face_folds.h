@@ -12,8 +12,11 @@
 /// moved inside the triangle of the other three. The metrics add degenerate (collapsed) triangles,
 /// which need the source triangle, to their `folds`.
 ///
-/// SpringSystem::folded_corners is the solver's own, stricter guard (each corner against its own
-/// normal); it is what the line search keeps, not what a map is judged by.
+/// The solvers guard the same test: SpringSystem::folded_corners (what the line search keeps) and
+/// the injectivity barrier (infinite as a triangle inverts) see each triangle along the sum of its
+/// corners' normals. Until 2026-12-04 they used each corner's own normal, which disagrees with this
+/// test where the normal turns by more than 90 degrees within one face: a quad wrapping the
+/// armadillo's snout converged "fold-free" for the solver and folded for the report.
 
 #include <Eigen/Core>
 #include <vector>

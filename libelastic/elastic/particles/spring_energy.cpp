@@ -11,6 +11,7 @@
 #include <string>
 
 #include "elastic/core/error.h"
+#include "elastic/particles/face_folds.h"
 
 namespace elastic {
 
@@ -244,9 +245,11 @@ int SpringSystem::set_barrier_mask(const Eigen::Matrix3Xd& x, const Eigen::Matri
   int left_out = 0;
   for (std::size_t t = 0; t < barrier_.size(); ++t) {
     const BarrierTriangle& b = barrier_[t];
-    const Eigen::Vector3d xi = x.col(b.i);
-    const double orientation = (x.col(b.next) - xi).cross(x.col(b.prev) - xi).dot(normals.col(b.i));
-    barrier_active_[t] = orientation > 0.0 ? 1 : 0;
+    barrier_active_[t] =
+        triangle_inverted(x.col(b.i), x.col(b.next), x.col(b.prev), normals.col(b.i),
+                          normals.col(b.next), normals.col(b.prev))
+            ? 0
+            : 1;
     left_out += barrier_active_[t] ? 0 : 1;
   }
   return left_out;
@@ -346,8 +349,9 @@ double SpringSystem::angular_energy(const Eigen::Matrix3Xd& x, bool want_gradien
 // Injectivity barrier: mu C w A h(g), g = sigma^2 tr(B G) det(S^T S) / D with
 // G = T^T T the target Gram matrix and D = det(G) = |c|^2, c = T0 x T1 (Lagrange's identity;
 // the cross product keeps a sliver's D accurate where G00 G11 - G01^2 would cancel to
-// round-off), or with normals D = (c . n)^2, the area seen along the apex normal n (header).
-// With q = sigma^2 det(S^T S), a = tr(B G) and m = c (or (c . n) n), both terms are functions
+// round-off), or with normals D = (c . u)^2, the area seen along the unit sum u of the three
+// corners' normals (header).
+// With q = sigma^2 det(S^T S), a = tr(B G) and m = c (or (c . u) u), both terms are functions
 // of a and D (dg/da = q / D, dg/dD = -g / D), so dE/dT = dE/da da/dT + dE/dD dD/dT with
 //   da/dT0 = 2 (b00 T0 + b01 T1),   da/dT1 = 2 (b11 T1 + b01 T0),
 //   dD/dT0 = 2 T1 x m,              dD/dT1 = 2 m x T0.
@@ -382,15 +386,19 @@ Eigen::Vector2d SpringSystem::triangle_energy(const Eigen::Matrix3Xd& x,
           const Eigen::Vector3d t1 = x.col(b.prev) - x.col(b.i);
           const Eigen::Vector3d c = t0.cross(t1);
           Eigen::Vector3d m = c;
-          double seen = 0.0;  // c . n_i, with normals
+          Eigen::Vector3d u = Eigen::Vector3d::Zero();  // unit sum of the corner normals
+          double seen = 0.0, sum_norm = 0.0;            // c . u and |n_i + n_next + n_prev|
           if (normals != nullptr) {
-            const Eigen::Vector3d n = normals->col(b.i);
-            seen = c.dot(n);
-            if (!(seen > 0.0)) {
+            const Eigen::Vector3d s =
+                normals->col(b.i) + normals->col(b.next) + normals->col(b.prev);
+            sum_norm = s.norm();
+            u = s / sum_norm;
+            seen = c.dot(u);
+            if (!(sum_norm > 0.0) || !(seen > 0.0)) {
               sum[0] += std::numeric_limits<double>::infinity();
               continue;
             }
-            m = seen * n;
+            m = seen * u;
           }
           const double D = m.squaredNorm();
           if (!(D > 0.0)) {
@@ -439,8 +447,10 @@ Eigen::Vector2d SpringSystem::triangle_energy(const Eigen::Matrix3Xd& x,
           barrier_force_.col(col + 1) = f0;
           barrier_force_.col(col + 2) = f1;
           if (normals != nullptr) {
-            // dE/dn = dE/dD dD/dn with D = (c . n)^2: dE/dD * 2 (c . n) c.
-            barrier_normal_force_.col(static_cast<Eigen::Index>(t)) = (2.0 * de_dd * seen) * c;
+            // dE/dn_j for each corner j: with s = n_i + n_next + n_prev, u = s / |s| and
+            // D = (c . u)^2, dD/dn_j = dD/ds = 2 (c . u) (I - u u^T) c / |s|.
+            barrier_normal_force_.col(static_cast<Eigen::Index>(t)) =
+                (2.0 * de_dd * seen / sum_norm) * (c - seen * u);
           }
         }
         return sum;
@@ -482,7 +492,7 @@ void SpringSystem::gather_gradient(bool with_barrier, Eigen::Matrix3Xd& gradient
                     });
 }
 
-// dE/dn_p: the apex entries (role 0) of the barrier triangles, in the fixed incidence order.
+// dE/dn_p: the entries of the barrier triangles at p (any role), in the fixed incidence order.
 void SpringSystem::gather_normal_gradient(Eigen::Matrix3Xd& normal_gradient) const {
   normal_gradient.resize(3, num_particles_);
   tbb::parallel_for(tbb::blocked_range<int>(0, num_particles_, static_cast<int>(kGrain)),
@@ -490,10 +500,8 @@ void SpringSystem::gather_normal_gradient(Eigen::Matrix3Xd& normal_gradient) con
                       for (int p = range.begin(); p != range.end(); ++p) {
                         Eigen::Vector3d g = Eigen::Vector3d::Zero();
                         for (int k = barrier_offset_[p]; k < barrier_offset_[p + 1]; ++k) {
-                          const int code = barrier_entry_[k];
-                          if (code % 3 == 0) {
-                            g += barrier_normal_force_.col(code / 3);
-                          }
+                          // Every corner of a triangle has the same dE/dn (its sum s).
+                          g += barrier_normal_force_.col(barrier_entry_[k] / 3);
                         }
                         normal_gradient.col(p) = g;
                       }
@@ -503,18 +511,18 @@ void SpringSystem::gather_normal_gradient(Eigen::Matrix3Xd& normal_gradient) con
 void SpringSystem::folded_corners(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& normals,
                                   std::vector<char>& folded) const {
   folded.resize(corners_.size());
-  tbb::parallel_for(
-      tbb::blocked_range<std::size_t>(0, corners_.size(), kGrain),
-      [&](const tbb::blocked_range<std::size_t>& range) {
-        for (std::size_t c = range.begin(); c != range.end(); ++c) {
-          const Corner& corner = corners_[c];
-          const Eigen::Vector3d xi = x.col(corner.i);
-          const double orientation =
-              (x.col(corner.next) - xi).cross(x.col(corner.prev) - xi).dot(normals.col(corner.i));
-          // "<= 0" also flags degenerate (collapsed) corners; NaN counts as folded.
-          folded[c] = !(orientation > 0.0);
-        }
-      });
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, corners_.size(), kGrain),
+                    [&](const tbb::blocked_range<std::size_t>& range) {
+                      for (std::size_t c = range.begin(); c != range.end(); ++c) {
+                        const Corner& corner = corners_[c];
+                        const Eigen::Vector3d xi = x.col(corner.i);
+                        // The one fold test (face_folds.h): against the sum of the three corners'
+                        // normals; degenerate (collapsed) corners and NaN count as folded.
+                        folded[c] = triangle_inverted(
+                            xi, x.col(corner.next), x.col(corner.prev), normals.col(corner.i),
+                            normals.col(corner.next), normals.col(corner.prev));
+                      }
+                    });
 }
 
 int SpringSystem::folded_faces(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& normals) const {

@@ -35,8 +35,8 @@
 ///   Gram-matrix form, with S, T the 3 x 2 edge matrices of the source and target triangle:
 ///       g = sigma^2 tr((S^T S)^-1 T^T T) det(S^T S) / det(T^T T),
 ///   smooth in the target positions, infinite as the target triangle collapses (det(T^T T) -> 0;
-///   given surface normals, evaluate() uses the signed area seen along the apex normal instead,
-///   infinite as the triangle folds in folded_corners()' sense),
+///   given surface normals, evaluate() uses the signed area seen along the unit sum of its three
+///   corners' normals instead, infinite as the triangle folds in face_folds.h's sense),
 ///   and zero unless the smaller stretch falls to about 1/sqrt(g0) = barrier_sigma (g0 =
 ///   barrier_sigma^-2): it leaves every triangle that is not close to collapse alone, so the
 ///   paper's minimum is unchanged wherever it is not degenerate. It is the barrier of Smith and
@@ -148,29 +148,33 @@ class SpringSystem {
 
   /// Energies at positions `x` (3 x #P); when `gradient` is given it receives dE/dx (3 x #P,
   /// resized). With `normals` (3 x #P unit surface normals at the particles) the barrier measures
-  /// each triangle's area as seen along the normal n_i at its apex, signed: det(T^T T) becomes
-  /// ((T0 x T1) . n_i)^2 and a triangle with (T0 x T1) . n_i <= 0 has infinite energy, so that the
-  /// barrier guards exactly what folded_corners() tests (a thin triangle standing up from the
-  /// surface has a fine 3D area but is folded as seen from it). The gradient holds the normals
-  /// fixed; `normal_gradient` (with `normals` only) receives dE/dn_p, the barrier's derivative
-  /// with respect to each particle's normal (3 x #P, resized; zero where p is no active barrier
-  /// triangle's apex). A solver whose normals follow the positions on a surface (n_p = n(x_p))
-  /// adds dn/dx_p^T dE/dn_p to the gradient (LimitSurface::normal_variation_adjoint) and so
-  /// differentiates the energy it evaluates. Without normals: the unsigned 3D area.
+  /// each triangle's area as seen along u = s / |s|, s = n_i + n_next + n_prev the sum of its
+  /// corners' normals, signed: det(T^T T) becomes ((T0 x T1) . u)^2 and a triangle with
+  /// (T0 x T1) . u <= 0 has infinite energy, so that the barrier guards exactly the fold test of
+  /// face_folds.h, which folded_corners() and the map's report share (a thin triangle standing up
+  /// from the surface has a fine 3D area but is folded as seen from it). The gradient holds the
+  /// normals fixed; `normal_gradient` (with `normals` only) receives dE/dn_p, the barrier's
+  /// derivative with respect to each particle's normal (3 x #P, resized; zero where p is the
+  /// corner of no active barrier triangle). A solver whose normals follow the positions on a
+  /// surface (n_p = n(x_p)) adds dn/dx_p^T dE/dn_p to the gradient
+  /// (LimitSurface::normal_variation_adjoint) and so differentiates the energy it evaluates.
+  /// Without normals: the unsigned 3D area.
   SpringEnergies evaluate(const Eigen::Matrix3Xd& x, Eigen::Matrix3Xd* gradient = nullptr,
                           const Eigen::Matrix3Xd* normals = nullptr,
                           Eigen::Matrix3Xd* normal_gradient = nullptr) const;
 
   /// Number of grid faces with at least one folded corner at positions `x`, given unit surface
   /// normals `normals` (3 x #P) at the particles. A corner (prev, i, next) of a counter-clockwise
-  /// face is folded when ((x_next - x_i) x (x_prev - x_i)) . n_i <= 0.
+  /// face is folded when its triangle is inverted in the sense of face_folds.h:
+  /// ((x_next - x_i) x (x_prev - x_i)) . (n_i + n_next + n_prev) <= 0. For triangles and quads
+  /// (whose four corners are the four triangles of its two splits) this is inverted_faces().
   int folded_faces(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& normals) const;
   /// Per corner (in the order of `corners()`), whether it is folded.
   void folded_corners(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& normals,
                       std::vector<char>& folded) const;
 
   /// Leaves out of the barrier every barrier triangle that is inverted at `x` (normals: 3 x #P unit
-  /// surface normals, the fold test of folded_corners at the triangle's apex) and puts every other
+  /// surface normals, the fold test of folded_corners) and puts every other
   /// one in. Returns the number left out. Without a call every triangle is in.
   int set_barrier_mask(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& normals);
   /// Number of barrier triangles (both splits of each quad and every triangle face).

@@ -519,10 +519,10 @@ class LbfgsRun {
   }
 
   // Evaluates the trial: the Armijo condition, or within the energy's round-off a smaller
-  // tangential gradient. The barrier sees each triangle along its apex's own surface normal
-  // (SpringSystem::evaluate), and the gradient includes the turning of those normals as the apex
-  // moves (add_normal_motion), so that every trial, every iterate and the slope belong to one
-  // function of the positions. (Normals held fixed through each line search and re-taken at the
+  // tangential gradient. The barrier sees each triangle along the sum of its corners' surface
+  // normals (SpringSystem::evaluate), and the gradient includes the turning of those normals as the
+  // corners move (add_normal_motion), so that every trial, every iterate and the slope belong to
+  // one function of the positions. (Normals held fixed through each line search and re-taken at the
   // accepted point made the energy jump between iterations: the solver stalled at its iteration
   // limit on the robustness benchmark's tightest cases.)
   bool acceptable(double alpha) {

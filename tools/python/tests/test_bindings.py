@@ -249,7 +249,7 @@ def test_distortion_guard_matches_the_tools_flag(plane, tmp_path):
     # A flat disk onto the top of spot's back: the guard acts (docs/solvers.md); off, it does not.
     job = {"source": str(MESHES / "grid.off"), "source-region": "disk:0.5,0.5,0,0.45",
            "target": str(MESHES / "spot.obj"), "target-region": "disk:0.181,0.946,-0.245,0.3",
-           "particles": 1000}
+           "particles": 1500}
     spot = elastic.Surface(job["target"])
     lengths = {}
     for guard in (True, False):
