@@ -165,10 +165,10 @@ void lift_off_the_plane(unsigned seed, Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& no
 }
 
 // With normals the barrier sees each triangle's area along its corners' summed normal: on a plane
-// with the
-// plane's normal it is the 3D barrier exactly; off the plane (normals tilted, heights random) its
-// gradients match central differences (expect_triangle_gradients); a triangle that stands up from
-// the surface (its plane containing the normal) has a finite 3D barrier but is infinite as seen.
+// with the plane's normal it is the 3D barrier exactly; off the plane (normals tilted, heights
+// random) its gradients match central differences (expect_triangle_gradients); a triangle that
+// stands up from the surface (its plane containing the normal) has a finite 3D barrier but is
+// infinite as seen.
 TEST(SpringEnergy, BarrierSeenAlongTheNormals) {
   const ParticleGrid grid = test::make_quad_grid(4, 3, 1.0);
   const SpringSystem system(grid, barrier_test_options(true));
@@ -228,21 +228,24 @@ TEST(SpringEnergy, SolverGuardBarrierAndReportShareOneFoldTest) {
     system.set_barrier_mask(x, everywhere);  // the barrier over the triangles unfolded along +z
     const double barrier = system.evaluate(x, nullptr, &normals).barrier;
     bool inverted_in_barrier = false;
-    int own_normal = 0, last_face = -1;
+    int own_normal = 0, last_face = -1, written_out = 0, last_inverted_face = -1;
     for (const SpringSystem::Corner& c : system.corners()) {
+      // The definition written out here, not taken from face_folds.h.
+      const Eigen::Vector3d area = (x.col(c.next) - x.col(c.i)).cross(x.col(c.prev) - x.col(c.i));
       const bool inverted =
-          triangle_inverted(x.col(c.i), x.col(c.next), x.col(c.prev), normals.col(c.i),
-                            normals.col(c.next), normals.col(c.prev));
-      const bool up = (x.col(c.next) - x.col(c.i)).cross(x.col(c.prev) - x.col(c.i)).z() > 0.0;
-      inverted_in_barrier = inverted_in_barrier || (inverted && up);
-      const bool own =
-          !((x.col(c.next) - x.col(c.i)).cross(x.col(c.prev) - x.col(c.i)).dot(normals.col(c.i)) >
-            0.0);
+          !(area.dot(normals.col(c.i) + normals.col(c.next) + normals.col(c.prev)) > 0.0);
+      inverted_in_barrier = inverted_in_barrier || (inverted && area.z() > 0.0);
+      if (inverted && c.face != last_inverted_face) {
+        ++written_out;
+        last_inverted_face = c.face;
+      }
+      const bool own = !(area.dot(normals.col(c.i)) > 0.0);
       if (own && c.face != last_face) {
         ++own_normal;
         last_face = c.face;
       }
     }
+    EXPECT_EQ(written_out, report) << "trial " << trial;
     EXPECT_EQ(std::isinf(barrier), inverted_in_barrier) << "trial " << trial;
     folded_configurations += report > 0 ? 1 : 0;
     own_normal_disagrees += own_normal != report ? 1 : 0;

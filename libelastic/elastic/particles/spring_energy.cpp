@@ -392,9 +392,11 @@ Eigen::Vector2d SpringSystem::triangle_energy(const Eigen::Matrix3Xd& x,
             const Eigen::Vector3d s =
                 normals->col(b.i) + normals->col(b.next) + normals->col(b.prev);
             sum_norm = s.norm();
-            u = s / sum_norm;
-            seen = c.dot(u);
-            if (!(sum_norm > 0.0) || !(seen > 0.0)) {
+            if (sum_norm > 0.0) {
+              u = s / sum_norm;
+              seen = c.dot(u);
+            }
+            if (!(seen > 0.0)) {  // also |s| = 0 (opposed normals) and NaN
               sum[0] += std::numeric_limits<double>::infinity();
               continue;
             }
