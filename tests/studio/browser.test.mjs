@@ -164,14 +164,32 @@ test('dragging the target region re-solves live, warm-started', async () => {
       await new Promise((r) => setTimeout(r, 60));
     } else {
       const n = await page.evaluate(() => window.studio.liveLog.length);
-      await page.waitForFunction((k) => window.studio.liveLog.length > k && !window.studio.liveBusy,
-        { timeout: 600000 }, n);
+      // A re-solve that fails shows its message instead of adding to the log: stop waiting then.
+      // The wait is bounded: a step whose update is still in flight after it fails the test with
+      // the page's state (a server that stops answering), one the page sent no request for (the
+      // move never reached the page) is logged and the drag goes on; the count below still needs
+      // six updates.
+      const outcome = await page.waitForFunction((k) => window.studio.error !== '' ||
+        (window.studio.liveLog.length > k && !window.studio.liveBusy), { timeout: 120000 }, n)
+        .then(() => '', (e) => e.message);
+      const state = await page.evaluate(() => ({
+        error: window.studio.error, busy: window.studio.liveBusy, log: window.studio.liveLog.length,
+        result: window.studio.result !== null, spec: window.studio.specs.target,
+        status: window.studio.status }));
+      if (state.error !== '' || (outcome !== '' && state.busy)) {
+        await page.mouse.up();
+        await page.keyboard.up('Control');
+        assert.fail(`drag step ${i} (log had ${n} updates): ${outcome} ${JSON.stringify(state)}`);
+      }
+      if (outcome !== '') console.log(`drag step ${i}: no update asked for: ${JSON.stringify(state)}`);
     }
   }
   await page.mouse.up();
   await page.keyboard.up('Control');
   // The drag's end asks for a converged map.
-  await page.waitForFunction(() => window.studio.live?.final, { timeout: 600000 });
+  await page.waitForFunction(() => window.studio.live?.final || window.studio.error !== '',
+    { timeout: 600000 });
+  assert.equal(await page.evaluate(() => window.studio.error), '');
   const { live, liveLog } = await page.evaluate(() => window.studio);
   assert.equal(live.folds, 0);
   // Which drag steps were solved depends on the server's pace (they merge), so the final solve's
