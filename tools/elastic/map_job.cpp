@@ -169,7 +169,7 @@ void add_map_flags(CLI::App& sub, MapJob& a) {
                  "(the paper's springs alone, as in Table 1)")
       ->check(CLI::IsMember({"robust", "paper"}));
   sub.add_option("--angular-stiffness", a.angular_stiffness,
-                 "auto (default: 0.3 with --energy robust, 1 with --energy paper or --solver "
+                 "auto (default: 0.25 with --energy robust, 1 with --energy paper or --solver "
                  "explicit) or the stiffness of the angular springs relative to the normal "
                  "springs, 0..100")
       ->check(CLI::IsMember({"auto"}) | CLI::Range(0.0, 100.0));
