@@ -158,7 +158,8 @@ EnergyKind parse_energy_kind(std::string_view text, std::string_view input = "en
 /// length energy's minimum (eq. 13) wherever source and target differ in shape. On the robustness
 /// cases (docs/results.md) 0.3 lowered the length energy by 5-30% with the symmetric Dirichlet
 /// energy within 1% of C_a = C (measured at 0.3, 1 and 3), and 0.25 by up to 20% more than 0.3
-/// with the symmetric Dirichlet energy within 0.2% of it (docs/solvers.md).
+/// with the symmetric Dirichlet energy within 0.3% of it (measured at 0.25 and 0.3 only; lower
+/// values untried; docs/solvers.md).
 inline constexpr double kPaperAngularStiffness = 1.0;
 inline constexpr double kRobustAngularStiffness = 0.25;
 
