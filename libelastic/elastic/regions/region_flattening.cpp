@@ -1,14 +1,19 @@
 #include "elastic/regions/region_flattening.h"
 
+#include <tbb/parallel_for.h>
+
 #include <Eigen/Geometry>
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseCore>
 #include <Eigen/SparseLU>
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <optional>
 
 #include "elastic/core/error.h"
+#include "elastic/numerics/bicgstab.h"
+#include "elastic/numerics/multigrid.h"
 
 namespace elastic {
 namespace {
@@ -43,6 +48,82 @@ int count_folds(const Region& region, const std::vector<Eigen::Vector2d>& uv) {
     }
   }
   return folds;
+}
+
+/// Interior unknowns from which the mean-value system is solved iteratively rather than by a sparse
+/// LU: below it the LU takes a few milliseconds.
+constexpr Eigen::Index kIterativeMeanValueSize = 4096;
+
+/// The mean-value system by sparse LU.
+Eigen::MatrixXd solve_mean_value_lu(const Eigen::SparseMatrix<double>& a,
+                                    const Eigen::MatrixXd& rhs, const std::string& name) {
+  Eigen::SparseLU<Eigen::SparseMatrix<double>> solver;
+  solver.compute(a);
+  if (solver.info() != Eigen::Success) {
+    throw NumericalError(name, "flattening: the mean-value system is singular");
+  }
+  Eigen::MatrixXd x = solver.solve(rhs);
+  if (solver.info() != Eigen::Success || !x.allFinite()) {
+    throw NumericalError(name, "flattening: the mean-value solve failed");
+  }
+  return x;
+}
+
+/// Solves the mean-value system A X = R (one column per disk coordinate).
+///
+/// A is a nonsymmetric M-matrix: positive diagonal a_ii = sum_j w_ij, off-diagonal -w_ij <= 0,
+/// rows summing to the weights towards boundary vertices (>= 0). A sparse LU of it costs
+/// O(n^1.5) on a 2D mesh: 0.36 s of the 0.55 s naive map of grid.off's disk onto the whole
+/// 28,561-vertex hemisphere.off (5,775 particles, 2 threads). Above
+/// kIterativeMeanValueSize unknowns it is solved instead by BiCGSTAB (numerics/bicgstab.h) to a
+/// relative residual of 1e-12, preconditioned by one AMG V-cycle (numerics/multigrid.h) on the
+/// symmetrised Laplacian P: off-diagonal -(w_ij + w_ji) / 2, diagonal chosen so that P's rows sum
+/// to A's. P is then a weakly diagonally dominant symmetric M-matrix tied to the boundary, hence
+/// positive definite, and it differs from A only by the asymmetry of the weights, which is small on
+/// a well-shaped mesh. The plain symmetric part (A + A^T) / 2 would not do: its rows sum to
+/// sum_j (w_ij - w_ji) / 2, which can be negative, so it need not be definite. A system the
+/// iteration does not solve falls back to the sparse LU. On the hemisphere BiCGSTAB takes 9
+/// iterations per coordinate and the naive map 0.22 s.
+Eigen::MatrixXd solve_mean_value(const Eigen::SparseMatrix<double>& a, const Eigen::MatrixXd& rhs,
+                                 const std::string& name) {
+  const Eigen::Index n = a.rows();
+  if (n < kIterativeMeanValueSize) {
+    return solve_mean_value_lu(a, rhs, name);
+  }
+  const Eigen::VectorXd ones = Eigen::VectorXd::Ones(n);
+  const Eigen::VectorXd row_sums = a * ones;
+  Eigen::SparseMatrix<double> p = 0.5 * (a + Eigen::SparseMatrix<double>(a.transpose()));
+  const Eigen::VectorXd p_sums = p * ones;
+  for (Eigen::Index i = 0; i < n; ++i) {
+    p.coeffRef(i, i) += row_sums[i] - p_sums[i];
+  }
+  std::optional<Multigrid> multigrid;
+  try {
+    multigrid.emplace(p);
+  } catch (const Error&) {
+    return solve_mean_value_lu(a, rhs, name);  // e.g. an unknown without weights: LU says why
+  }
+  const LinearOperator apply_a = [&](const Eigen::VectorXd& in, Eigen::VectorXd& out) {
+    out.noalias() = a * in;
+  };
+  const LinearOperator apply_b = [&](const Eigen::VectorXd& in, Eigen::VectorXd& out) {
+    out = multigrid->apply(in);
+  };
+  Eigen::MatrixXd x(n, rhs.cols());
+  std::vector<char> solved(static_cast<size_t>(rhs.cols()), 0);
+  // The columns are independent solves; the multigrid allows concurrent applications.
+  tbb::parallel_for(Eigen::Index{0}, rhs.cols(), [&](Eigen::Index c) {
+    Eigen::VectorXd column;
+    const BicgstabResult r = bicgstab(apply_a, apply_b, rhs.col(c), column);
+    if (r.converged && column.allFinite()) {
+      x.col(c) = column;
+      solved[static_cast<size_t>(c)] = 1;
+    }
+  });
+  if (std::find(solved.begin(), solved.end(), 0) != solved.end()) {
+    return solve_mean_value_lu(a, rhs, name);
+  }
+  return x;
 }
 
 /// Floater's mean-value coordinates (Floater 2003, "Mean value coordinates", CAGD 20(1)):
@@ -113,15 +194,7 @@ RegionFlattening flatten_disk(const Region& region) {
     }
     Eigen::SparseMatrix<double> a(free, free);
     a.setFromTriplets(trip.begin(), trip.end());
-    Eigen::SparseLU<Eigen::SparseMatrix<double>> solver;
-    solver.compute(a);
-    if (solver.info() != Eigen::Success) {
-      throw NumericalError(name, "flattening: the mean-value system is singular");
-    }
-    const Eigen::MatrixXd x = solver.solve(rhs);
-    if (solver.info() != Eigen::Success || !x.allFinite()) {
-      throw NumericalError(name, "flattening: the mean-value solve failed");
-    }
+    const Eigen::MatrixXd x = solve_mean_value(a, rhs, name);
     for (int v = 0; v < nv; ++v) {
       const int r = index[static_cast<size_t>(v)];
       if (r >= 0) {
