@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <random>
 
 #include "elastic/core/error.h"
 #include "elastic/image/image.h"
@@ -341,6 +342,68 @@ TEST(Render, IsDeterministicWhateverTheThreadCount) {
   EXPECT_FALSE(one.pixels == other.pixels);
 }
 
+// Adaptive antialiasing against every pixel traced with all its rays (threshold 0), on a scene
+// with everything that makes edges: a sphere's silhouette over the background, per-face colours
+// (a random heatmap, so neighbouring faces differ), and a wireframe thinner than a pixel lying on
+// the surface, whose tubes centre rays mostly miss. Pixels the wires darken, and silhouette pixels,
+// must be the full computation bit for bit; elsewhere the picture stays within a few levels.
+TEST(Render, AdaptiveAntialiasingKeepsEdgesAndThinWiresExactly) {
+  ShapeOptions shape;
+  shape.faces = ShapeFaces::Quads;
+  shape.resolution = 12;
+  SceneObject sphere{make_sphere(shape), {}};
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> u(0.2f, 0.9f);
+  for (int f = 0; f < sphere.mesh.num_faces(); ++f) {
+    sphere.mesh.face_colors.emplace_back(u(rng), u(rng), u(rng));
+  }
+  sphere.look.colors = SurfaceColoring::FaceColors;
+  ShapeOptions grid_shape = shape;
+  grid_shape.resolution = 7;  // its edges cross the coloured faces rather than follow their sides
+  SceneObject grid{make_sphere(grid_shape), {}};
+  grid.look.surface = false;
+  grid.look.wireframe = true;
+  grid.look.wire_width_px = 0.15;
+  grid.look.wire_color = {0.0f, 0.0f, 0.0f};
+  Scene scene;
+  scene.objects = {sphere, grid};
+  const Camera camera = frame_box(bounding_box(scene), {0.3, -0.2, 1.0}, 40.0, 160, 160);
+  RenderOptions options;
+  options.transparent_background = true;  // silhouette pixels: alpha strictly between 0 and 1
+  RenderOptions full_options = options;
+  full_options.adaptive_threshold = 0.0;
+  const Image full = render(scene, camera, full_options);
+  const Image adaptive = render(scene, camera, options);
+  scene.objects.pop_back();
+  const Image no_wires = render(scene, camera, full_options);
+
+  int wire_pixels = 0, edge_pixels = 0, differing = 0;
+  double sum = 0.0;
+  for (int y = 0; y < camera.height; ++y) {
+    for (int x = 0; x < camera.width; ++x) {
+      const Eigen::Vector4f& f = full.at(x, y);
+      const Eigen::Vector4f& a = adaptive.at(x, y);
+      const float darkened = (no_wires.at(x, y) - f).head<3>().maxCoeff();
+      if (darkened > 0.02f) {
+        ++wire_pixels;
+        EXPECT_EQ(a, f) << "wire pixel " << x << "," << y;
+      }
+      if (f.w() > 0.0f && f.w() < 1.0f) {
+        ++edge_pixels;
+        EXPECT_EQ(a, f) << "silhouette pixel " << x << "," << y;
+      }
+      const float d = (a - f).cwiseAbs().maxCoeff();
+      sum += static_cast<double>(d);
+      differing += d > 0.0f ? 1 : 0;
+      EXPECT_LT(d, 0.12f) << x << "," << y;
+    }
+  }
+  EXPECT_GT(wire_pixels, 100);  // the wires show in the full picture
+  EXPECT_GT(edge_pixels, 100);
+  EXPECT_GT(differing, 300);  // the adaptive picture is not just the full one
+  EXPECT_LT(sum / (camera.width * camera.height), 2.0 / 255.0);
+}
+
 TEST(Render, WritesAPngThatReadsBack) {
   Scene scene;
   scene.objects.push_back({make_cap(), {}});
@@ -378,6 +441,11 @@ TEST(Render, RejectsInconsistentInput) {
   scene.objects[0].mesh = grid_plane(1);
   RenderOptions options;
   options.samples_per_pixel = 0;
+  EXPECT_THROW(render(scene, camera, options), InvalidInputError);
+  options = {};
+  options.adaptive_threshold = 1.5;
+  EXPECT_THROW(render(scene, camera, options), InvalidInputError);
+  options.adaptive_threshold = std::nan("");
   EXPECT_THROW(render(scene, camera, options), InvalidInputError);
   // A texture file that is not there: read_image's error, naming the file.
   scene.objects[0].mesh.materials.push_back(Material{"m", {1, 1, 1}, "/nonexistent/texture.png"});

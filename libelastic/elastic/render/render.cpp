@@ -60,6 +60,7 @@ struct PreparedObject {
   std::vector<Eigen::Vector3d> vertex_normals;       // unit, or zero where undefined
   std::vector<std::array<int, 3>> triangle_corners;  // corner indices (into face_vertices)
   std::vector<int> triangle_face;
+  std::vector<std::pair<int, int>> wire_edges;  // the wireframe's polygon edges (vertex pairs)
   double wire_radius = 0.0;
 };
 
@@ -288,8 +289,10 @@ class Tracer {
     wire_slack_ = static_cast<float>(options.wire_depth_tolerance * diagonal_);
   }
 
-  /// Premultiplied RGBA seen along the ray from the eye through continuous pixel (px, py).
-  Eigen::Vector4f trace(double px, double py, SampleRandom& random) const {
+  /// Premultiplied RGBA seen along the ray from the eye through continuous pixel (px, py). `seen`,
+  /// when given, receives what the ray hit: -1 the background, k object k's surface, n + k object
+  /// k's wireframe (n objects).
+  Eigen::Vector4f trace(double px, double py, SampleRandom& random, int* seen = nullptr) const {
     const Eigen::Vector3d direction = camera_ray_direction(camera_, frame_, px, py);
     const Eigen::Vector3d origin = camera_.eye - shift_;
     const Eigen::Vector3d view = -direction;  // towards the eye
@@ -307,8 +310,11 @@ class Tracer {
     rtcIntersect1(wires_.get(), &context, &wire);
 
     if (wire.hit.geomID != RTC_INVALID_GEOMETRY_ID) {
-      const PreparedObject& prepared =
-          prepared_[static_cast<size_t>(wire_objects_[wire.hit.geomID])];
+      const int object = wire_objects_[wire.hit.geomID];
+      if (seen != nullptr) {
+        *seen = static_cast<int>(prepared_.size()) + object;
+      }
+      const PreparedObject& prepared = prepared_[static_cast<size_t>(object)];
       Eigen::Vector3d n(wire.hit.Ng_x, wire.hit.Ng_y, wire.hit.Ng_z);
       n = n.norm() > 0.0 ? Eigen::Vector3d(n.normalized()) : view;
       if (n.dot(view) < 0.0) {
@@ -319,11 +325,17 @@ class Tracer {
       return {c.x() * light, c.y() * light, c.z() * light, 1.0f};
     }
     if (query.hit.geomID == RTC_INVALID_GEOMETRY_ID) {
+      if (seen != nullptr) {
+        *seen = -1;
+      }
       return background(py);
     }
 
-    const PreparedObject& prepared =
-        prepared_[static_cast<size_t>(surface_objects_[query.hit.geomID])];
+    const int object = surface_objects_[query.hit.geomID];
+    if (seen != nullptr) {
+      *seen = object;
+    }
+    const PreparedObject& prepared = prepared_[static_cast<size_t>(object)];
     const PolygonMesh& mesh = prepared.object->mesh;
     const std::array<int, 3>& corners = prepared.triangle_corners[query.hit.primID];
     const int face = prepared.triangle_face[query.hit.primID];
@@ -358,6 +370,60 @@ class Tracer {
     const Eigen::Vector3f base = surface_color(prepared, face, corners, vertex, b);
     const auto light = static_cast<float>(lighting(smooth, visibility));
     return {base.x() * light, base.y() * light, base.z() * light, 1.0f};
+  }
+
+  /// Sets busy[y * width + x] = 1 for every pixel within about a pixel of a wireframe edge's
+  /// projection (its tube's projected half width plus 1.5 pixels), whether or not the edge is
+  /// hidden: a conservative cover of the pixels a thin wire may touch between pixel centres.
+  void mark_wires(std::vector<unsigned char>& busy) const {
+    const int width = camera_.width, height = camera_.height;
+    // Pixels per world unit at depth 1 along the view axis.
+    const double pixels_per_unit = height / (2.0 * frame_.tan_half_height);
+    const double near = 1e-6 * std::max((camera_.target - camera_.eye).norm(), 1e-300);
+    // A segment longer than this on screen is marked over this many steps only (a wire passing
+    // through the eye's plane); the rest of it may alias.
+    const double max_steps = 8.0 * (width + height);
+    for (const PreparedObject& prepared : prepared_) {
+      const PolygonMesh& mesh = prepared.object->mesh;
+      for (const auto& [first, second] : prepared.wire_edges) {
+        Eigen::Vector3d a = mesh.positions[static_cast<size_t>(first)];
+        Eigen::Vector3d b = mesh.positions[static_cast<size_t>(second)];
+        double da = (a - camera_.eye).dot(frame_.forward),
+               db = (b - camera_.eye).dot(frame_.forward);
+        if (da < near && db < near) {
+          continue;
+        }
+        // Clip to the near plane.
+        if (da < near) {
+          a += (near - da) / (db - da) * (b - a);
+          da = near;
+        } else if (db < near) {
+          b += (near - db) / (da - db) * (a - b);
+          db = near;
+        }
+        const Eigen::Vector2d pa = project(camera_, a).pixel, pb = project(camera_, b).pixel;
+        const double steps = std::min(max_steps, std::ceil(2.0 * (pb - pa).norm()) + 1.0);
+        for (double i = 0.0; i <= steps; i += 1.0) {
+          const double t = i / steps;
+          const Eigen::Vector2d p = (1.0 - t) * pa + t * pb;
+          const double depth = (1.0 - t) * da + t * db;
+          const double reach = prepared.wire_radius * pixels_per_unit / depth + 1.5;
+          if (!(reach < width + height)) {
+            continue;  // so close to the eye that it covers the picture: left to the colour test
+          }
+          const auto x0 = static_cast<int>(std::floor(p.x() - reach));
+          const auto x1 = static_cast<int>(std::floor(p.x() + reach));
+          const auto y0 = static_cast<int>(std::floor(p.y() - reach));
+          const auto y1 = static_cast<int>(std::floor(p.y() + reach));
+          for (int y = std::max(y0, 0); y <= std::min(y1, height - 1); ++y) {
+            for (int x = std::max(x0, 0); x <= std::min(x1, width - 1); ++x) {
+              busy[static_cast<size_t>(y) * static_cast<size_t>(width) + static_cast<size_t>(x)] =
+                  1;
+            }
+          }
+        }
+      }
+    }
   }
 
  private:
@@ -451,7 +517,7 @@ class Tracer {
         return c;
       }
       case SurfaceColoring::Texture: {
-        const Eigen::Vector3f under = material_color(prepared, face);
+        Eigen::Vector3f under = material_color(prepared, face);
         const int m = mesh.face_materials[face];
         if (m < 0 || (*prepared.textures)[m].empty()) {
           return under;
@@ -525,9 +591,10 @@ class Tracer {
   }
 
   void add_curves(int k) {
-    const PreparedObject& prepared = prepared_[static_cast<size_t>(k)];
+    PreparedObject& prepared = prepared_[static_cast<size_t>(k)];
     const PolygonMesh& mesh = prepared.object->mesh;
-    const std::vector<std::pair<int, int>> edges = polygon_edges(mesh);
+    prepared.wire_edges = polygon_edges(mesh);
+    const std::vector<std::pair<int, int>>& edges = prepared.wire_edges;
     if (edges.empty()) {
       return;
     }
@@ -578,6 +645,9 @@ void check_options(const RenderOptions& options) {
   const auto bad = [](const std::string& what) { throw InvalidInputError("render", what); };
   if (options.samples_per_pixel < 1 || options.samples_per_pixel > 256) {
     bad("samples per pixel " + std::to_string(options.samples_per_pixel) + " is outside 1..256");
+  }
+  if (!(options.adaptive_threshold >= 0.0 && options.adaptive_threshold <= 1.0)) {
+    bad("adaptive threshold " + std::to_string(options.adaptive_threshold) + " is outside 0..1");
   }
   if (options.ambient_occlusion_samples < 0 || options.ambient_occlusion_samples > 256) {
     bad("ambient occlusion samples " + std::to_string(options.ambient_occlusion_samples) +
@@ -644,6 +714,54 @@ MaterialTextures load_material_textures(const PolygonMesh& mesh,
   return result;
 }
 
+namespace {
+
+constexpr int kTile = 16;
+
+/// Calls f(x, y) for every pixel, in parallel over 16 x 16 tiles (each pixel by one task).
+template <typename F>
+void for_pixels(const Camera& camera, const F& f) {
+  const int tiles_x = (camera.width + kTile - 1) / kTile;
+  const int tiles_y = (camera.height + kTile - 1) / kTile;
+  tbb::parallel_for(tbb::blocked_range<int>(0, tiles_x * tiles_y), [&](const auto& range) {
+    for (int tile = range.begin(); tile != range.end(); ++tile) {
+      const int x0 = (tile % tiles_x) * kTile, y0 = (tile / tiles_x) * kTile;
+      for (int y = y0; y < std::min(y0 + kTile, camera.height); ++y) {
+        for (int x = x0; x < std::min(x0 + kTile, camera.width); ++x) {
+          f(x, y);
+        }
+      }
+    }
+  });
+}
+
+/// Whether pixel (x, y) needs all its rays: a wire may touch it, or it or a neighbour (8-connected)
+/// sees something else at its centre, or their centre colours differ by more than `threshold` in
+/// a channel.
+bool needs_all_rays(int x, int y, int width, int height, const std::vector<Eigen::Vector4f>& centre,
+                    const std::vector<int>& seen, const std::vector<unsigned char>& busy,
+                    float threshold) {
+  const auto at = [&](int px, int py) {
+    return static_cast<size_t>(py) * static_cast<size_t>(width) + static_cast<size_t>(px);
+  };
+  const size_t here = at(x, y);
+  if (busy[here] != 0) {
+    return true;
+  }
+  for (int ny = std::max(y - 1, 0); ny <= std::min(y + 1, height - 1); ++ny) {
+    for (int nx = std::max(x - 1, 0); nx <= std::min(x + 1, width - 1); ++nx) {
+      const size_t there = at(nx, ny);
+      if (seen[there] != seen[here] ||
+          (centre[there] - centre[here]).cwiseAbs().maxCoeff() > threshold) {
+        return true;
+      }
+    }
+  }
+  return false;
+}
+
+}  // namespace
+
 Image render(const Scene& scene, const Camera& camera, const RenderOptions& options) {
   check_options(options);
   const int arena_threads = options.threads > 0 ? options.threads : tbb::task_arena::automatic;
@@ -656,37 +774,56 @@ Image render(const Scene& scene, const Camera& camera, const RenderOptions& opti
     // Stratify on a k x k grid when the sample count is a perfect square.
     const auto root = static_cast<int>(std::lround(std::sqrt(static_cast<double>(samples))));
     const bool stratified = root * root == samples;
-    constexpr int kTile = 16;
-    const int tiles_x = (camera.width + kTile - 1) / kTile;
-    const int tiles_y = (camera.height + kTile - 1) / kTile;
-    tbb::parallel_for(tbb::blocked_range<int>(0, tiles_x * tiles_y), [&](const auto& range) {
-      for (int tile = range.begin(); tile != range.end(); ++tile) {
-        const int x0 = (tile % tiles_x) * kTile, y0 = (tile / tiles_x) * kTile;
-        for (int y = y0; y < std::min(y0 + kTile, camera.height); ++y) {
-          for (int x = x0; x < std::min(x0 + kTile, camera.width); ++x) {
-            const auto pixel =
-                static_cast<std::uint64_t>(y) * static_cast<std::uint64_t>(camera.width) +
-                static_cast<std::uint64_t>(x);
-            Eigen::Vector4f sum = Eigen::Vector4f::Zero();
-            for (int s = 0; s < samples; ++s) {
-              SampleRandom jitter(options.seed, pixel, static_cast<std::uint64_t>(s), 0);
-              SampleRandom shading(options.seed, pixel, static_cast<std::uint64_t>(s), 1);
-              double jx = jitter.next(), jy = jitter.next();
-              if (stratified) {
-                jx = ((s % root) + jx) / root;
-                jy = ((s / root) + jy) / root;
-              }
-              sum += tracer.trace(x + jx, y + jy, shading);
-            }
-            Eigen::Vector4f average = sum / static_cast<float>(samples);
-            // Back from premultiplied alpha to the straight alpha Image stores.
-            if (average.w() > 0.0f) {
-              average.head<3>() /= average.w();
-            }
-            image.at(x, y) = average.cwiseMax(0.0f).cwiseMin(1.0f);
-          }
-        }
+    const auto index = [&](int x, int y) {
+      return static_cast<std::uint64_t>(y) * static_cast<std::uint64_t>(camera.width) +
+             static_cast<std::uint64_t>(x);
+    };
+    // Back from premultiplied alpha to the straight alpha Image stores.
+    const auto store = [&](int x, int y, Eigen::Vector4f average) {
+      if (average.w() > 0.0f) {
+        average.head<3>() /= average.w();
       }
+      image.at(x, y) = average.cwiseMax(0.0f).cwiseMin(1.0f);
+    };
+    // All `samples` jittered rays of a pixel, averaged.
+    const auto all_rays = [&](int x, int y) {
+      const std::uint64_t pixel = index(x, y);
+      Eigen::Vector4f sum = Eigen::Vector4f::Zero();
+      for (int s = 0; s < samples; ++s) {
+        SampleRandom jitter(options.seed, pixel, static_cast<std::uint64_t>(s), 0);
+        SampleRandom shading(options.seed, pixel, static_cast<std::uint64_t>(s), 1);
+        double jx = jitter.next(), jy = jitter.next();
+        if (stratified) {
+          // Stratum (column, row) = (s mod root, s div root).
+          const int column = s % root, row = s / root;
+          jx = (column + jx) / root;
+          jy = (row + jy) / root;
+        }
+        sum += tracer.trace(x + jx, y + jy, shading);
+      }
+      return Eigen::Vector4f(sum / static_cast<float>(samples));
+    };
+    if (samples == 1 || !(options.adaptive_threshold > 0.0)) {
+      for_pixels(camera, [&](int x, int y) { store(x, y, all_rays(x, y)); });
+      return;
+    }
+    // Adaptive antialiasing (see RenderOptions::adaptive_threshold): one ray through every pixel
+    // centre first (its own random stream, sample number `samples`), then all rays where needed.
+    const size_t count = static_cast<size_t>(camera.width) * static_cast<size_t>(camera.height);
+    std::vector<Eigen::Vector4f> centre(count);
+    std::vector<int> seen(count);
+    for_pixels(camera, [&](int x, int y) {
+      const std::uint64_t pixel = index(x, y);
+      SampleRandom shading(options.seed, pixel, static_cast<std::uint64_t>(samples), 1);
+      centre[pixel] = tracer.trace(x + 0.5, y + 0.5, shading, &seen[pixel]);
+    });
+    std::vector<unsigned char> busy(count, 0);
+    tracer.mark_wires(busy);
+    const auto threshold = static_cast<float>(options.adaptive_threshold);
+    for_pixels(camera, [&](int x, int y) {
+      const bool all =
+          needs_all_rays(x, y, camera.width, camera.height, centre, seen, busy, threshold);
+      store(x, y, all ? all_rays(x, y) : centre[index(x, y)]);
     });
   });
   return image;
