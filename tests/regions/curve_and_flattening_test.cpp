@@ -77,13 +77,29 @@ RegionSpec disk(const Eigen::Vector3d& c, double r) {
   return spec;
 }
 
-TEST(RegionFlattening, DiskMapIsBijectiveWithBoundaryOnTheCircleByArcLength) {
-  const Surface s(make_sphere({.faces = ShapeFaces::Quads, .resolution = 6}), 6);
-  const Region region =
-      make_region(*s.projector, disk(s.projector->closest({0.3, 0.8, 0.5}).position, 0.9));
-  const RegionFlattening flat = flatten_region(region);
+/// Floater's map of a disk of radius `radius` around the point of `s` (a sphere) nearest
+/// (0.3, 0.8, 0.5), into `region`; expected to be a disk map without folds.
+RegionFlattening sphere_disk_map(const Surface& s, double radius, Region& region) {
+  region = make_region(*s.projector, disk(s.projector->closest({0.3, 0.8, 0.5}).position, radius));
+  RegionFlattening flat = flatten_region(region);
   EXPECT_EQ(flat.method, FlatteningMethod::Disk);
   EXPECT_EQ(flat.folded_triangles, 0);
+  return flat;
+}
+
+/// 1 for the region's boundary vertices.
+std::vector<char> boundary_mask(const Region& region) {
+  std::vector<char> on_boundary(static_cast<size_t>(region.num_vertices()), 0);
+  for (int v : region.boundary) {
+    on_boundary[static_cast<size_t>(v)] = 1;
+  }
+  return on_boundary;
+}
+
+TEST(RegionFlattening, DiskMapIsBijectiveWithBoundaryOnTheCircleByArcLength) {
+  const Surface s(make_sphere({.faces = ShapeFaces::Quads, .resolution = 6}), 6);
+  Region region;
+  const RegionFlattening flat = sphere_disk_map(s, 0.9, region);
   const SurfaceCurve curve = region.boundary_curve();
   const auto cum = curve.arc_lengths();
   for (size_t k = 0; k < region.boundary.size(); ++k) {
@@ -93,10 +109,7 @@ TEST(RegionFlattening, DiskMapIsBijectiveWithBoundaryOnTheCircleByArcLength) {
     EXPECT_NEAR(p.y(), std::sin(angle), 1e-12);
   }
   // Interior vertices strictly inside the disk.
-  std::vector<char> on_boundary(flat.uv.size(), 0);
-  for (int v : region.boundary) {
-    on_boundary[static_cast<size_t>(v)] = 1;
-  }
+  const std::vector<char> on_boundary = boundary_mask(region);
   for (size_t v = 0; v < flat.uv.size(); ++v) {
     if (!on_boundary[v]) {
       EXPECT_LT(flat.uv[v].norm(), 1.0);
@@ -111,15 +124,9 @@ TEST(RegionFlattening, DiskMapIsBijectiveWithBoundaryOnTheCircleByArcLength) {
 // half-angle tangent formula), to a residual far below the map's own scale.
 TEST(RegionFlattening, LargeDiskMapSatisfiesTheMeanValueEquations) {
   const Surface s(make_sphere({.faces = ShapeFaces::Quads, .resolution = 6}), 28);
-  const Region region =
-      make_region(*s.projector, disk(s.projector->closest({0.3, 0.8, 0.5}).position, 1.2));
-  const RegionFlattening flat = flatten_region(region);
-  EXPECT_EQ(flat.method, FlatteningMethod::Disk);
-  EXPECT_EQ(flat.folded_triangles, 0);
-  std::vector<char> on_boundary(flat.uv.size(), 0);
-  for (int v : region.boundary) {
-    on_boundary[static_cast<size_t>(v)] = 1;
-  }
+  Region region;
+  const RegionFlattening flat = sphere_disk_map(s, 1.2, region);
+  const std::vector<char> on_boundary = boundary_mask(region);
   ASSERT_GT(region.num_vertices() - static_cast<int>(region.boundary.size()), 4096);
   std::vector<Eigen::Vector2d> sum(flat.uv.size(), Eigen::Vector2d::Zero());
   std::vector<double> weights(flat.uv.size(), 0.0);
