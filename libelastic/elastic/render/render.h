@@ -93,7 +93,7 @@ struct RenderOptions {
   /// premultiplied), or within about a pixel of a wireframe edge gets all `samples_per_pixel` rays
   /// (computed exactly as without adaptivity); elsewhere the centre ray is the pixel. 0: every
   /// pixel gets all rays. At the default, 4 / 255, `bash scripts/demo`'s previews trace all rays
-  /// through 4% of the pixels of the textured target, 15-18% of the heatmaps' and 27% of the grid
+  /// through 4% of the pixels of the textured target, 14-18% of the heatmaps' and 27% of the grid
   /// pictures'. A one-ray pixel differs from its full average by about the colour change across
   /// it, which its neighbours' centres bound unless an edge passes between them unseen.
   double adaptive_threshold = 4.0 / 255.0;
