@@ -126,7 +126,9 @@ Eigen::SparseMatrix<double> convection_diffusion(int n, double cx, double cy) {
                                                       {i * n + j + 1, 1.0 + std::max(-cx, 0.0)}}};
       for (const auto& [node, w] : nb) {
         t.emplace_back(r, r, w);
-        if (row[node] >= 0) t.emplace_back(r, row[node], -w);
+        if (row[node] >= 0) {
+          t.emplace_back(r, row[node], -w);
+        }
       }
     }
   }
@@ -147,7 +149,9 @@ TEST(Bicgstab, NonsymmetricSolveMatchesTheSparseLu) {
   Eigen::SparseMatrix<double> s = 0.5 * (a + Eigen::SparseMatrix<double>(a.transpose()));
   const Eigen::VectorXd ones = Eigen::VectorXd::Ones(a.rows());
   const Eigen::VectorXd fix = a * ones - s * ones;
-  for (Eigen::Index i = 0; i < a.rows(); ++i) s.coeffRef(i, i) += fix[i];
+  for (Eigen::Index i = 0; i < a.rows(); ++i) {
+    s.coeffRef(i, i) += fix[i];
+  }
   const Multigrid multigrid(s);
   const LinearOperator apply = [&](const Eigen::VectorXd& v, Eigen::VectorXd& out) { out = a * v; };
   const LinearOperator precondition = [&](const Eigen::VectorXd& v, Eigen::VectorXd& out) {

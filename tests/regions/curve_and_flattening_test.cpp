@@ -136,7 +136,9 @@ TEST(RegionFlattening, LargeDiskMapSatisfiesTheMeanValueEquations) {
       const auto j = static_cast<size_t>(t[(k + 1) % 3]), l = static_cast<size_t>(t[(k + 2) % 3]);
       const Eigen::Vector3d eij = region.positions[j] - region.positions[i];
       const Eigen::Vector3d eil = region.positions[l] - region.positions[i];
-      if (eij.norm() == 0.0 || eil.norm() == 0.0 || eij.cross(eil).norm() == 0.0) continue;
+      if (eij.norm() == 0.0 || eil.norm() == 0.0 || eij.cross(eil).norm() == 0.0) {
+        continue;
+      }
       const double angle = std::acos(std::clamp(eij.normalized().dot(eil.normalized()), -1.0, 1.0));
       for (const auto& [other, e] : {std::pair{j, eij}, std::pair{l, eil}}) {
         const double w = std::tan(angle / 2.0) / e.norm();
