@@ -157,6 +157,30 @@ TEST(Aiming, RenderFovZoomsFromTheSameEye) {
   EXPECT_GT(surface_fraction(read_image(dir / "zoom.png")), 0.97);
 }
 
+// --adaptive reaches the renderer: 0 traces every ray of every pixel, another picture than the
+// default's (which keeps one ray where nothing changes) but one that matches it wherever the
+// default traced all rays; a threshold outside 0..1 is a usage error.
+TEST(Aiming, RenderAdaptiveThresholdReachesTheRenderer) {
+  const fs::path dir = test::scratch_dir("aim_render_adaptive");
+  const std::string base = "render -q " + mesh("cap_quads.obj") + " --size 96x96 --edges ";
+  ASSERT_EQ(elastic(base + "--out " + (dir / "default.png").string(), dir).code, 0);
+  ASSERT_EQ(elastic(base + "--adaptive 0 --out " + (dir / "full.png").string(), dir).code, 0);
+  const Image full = read_image(dir / "full.png");
+  const Image adaptive = read_image(dir / "default.png");
+  int differing = 0, same = 0;
+  for (size_t k = 0; k < full.pixels.size(); ++k) {
+    const float d = (adaptive.pixels[k] - full.pixels[k]).cwiseAbs().maxCoeff();
+    differing += d > 0.0f ? 1 : 0;
+    same += d == 0.0f ? 1 : 0;
+  }
+  EXPECT_GT(differing, 0);
+  EXPECT_GT(same, 0);  // the edges' and the silhouette's pixels at least
+  const CliRun bad = elastic(base + "--adaptive 2 --out " + (dir / "bad.png").string(), dir);
+  EXPECT_EQ(bad.code, 64);
+  EXPECT_NE(bad.err.find("--adaptive"), std::string::npos) << bad.err;
+  EXPECT_FALSE(fs::exists(dir / "bad.png"));
+}
+
 TEST(Aiming, PasteHelpExplainsAnchorsAndOrientation) {
   const fs::path dir = test::scratch_dir("aim_help");
   const CliRun help = elastic("paste --help", dir);

@@ -37,6 +37,7 @@ struct RenderArgs {
   bool heatmap = false;
   bool edges = false;
   int samples = 4;
+  double adaptive = RenderOptions{}.adaptive_threshold;  ///< --adaptive
   int ao = 0;
   unsigned long seed = 1;
   bool transparent = false;
@@ -156,6 +157,7 @@ int run_render(const RenderArgs& args) {
 
   RenderOptions options;
   options.samples_per_pixel = args.samples;
+  options.adaptive_threshold = args.adaptive;
   options.ambient_occlusion_samples = args.ao;
   options.seed = args.seed;
   options.transparent_background = args.transparent;
@@ -206,6 +208,13 @@ ELASTIC_COMMAND(
       sub.add_flag("--edges", args->edges, "Also draw the meshes' own polygon edges");
       sub.add_option("--samples", args->samples, "Jittered rays per pixel (antialiasing)")
           ->check(CLI::Range(1, 256))
+          ->capture_default_str();
+      sub.add_option(
+             "--adaptive", args->adaptive,
+             "Adaptive antialiasing: a pixel gets all --samples rays only where its centre "
+             "ray and a neighbour's differ in object or by more than this in a colour "
+             "channel, or a wire passes near (0..1; 0: every pixel gets all; docs/render.md)")
+          ->check(CLI::Range(0.0, 1.0))
           ->capture_default_str();
       sub.add_option("--ao", args->ao, "Ambient-occlusion rays per hit (0: off)")
           ->check(CLI::Range(0, 256))
