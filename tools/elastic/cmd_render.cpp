@@ -52,14 +52,20 @@ Eigen::Vector2i parse_size(const std::string& text) {
   try {
     size_t used = 0;
     const int w = std::stoi(text.substr(0, x), &used);
-    if (used != (x == std::string::npos ? text.size() : x)) throw std::invalid_argument("w");
+    if (used != (x == std::string::npos ? text.size() : x)) {
+      throw std::invalid_argument("w");
+    }
     int h = w;
     if (x != std::string::npos) {
       const std::string rest = text.substr(x + 1);
       h = std::stoi(rest, &used);
-      if (used != rest.size()) throw std::invalid_argument("h");
+      if (used != rest.size()) {
+        throw std::invalid_argument("h");
+      }
     }
-    if (w < 1 || h < 1 || w > 16384 || h > 16384) throw std::out_of_range("size");
+    if (w < 1 || h < 1 || w > 16384 || h > 16384) {
+      throw std::out_of_range("size");
+    }
     return {w, h};
   } catch (const std::logic_error&) {
     throw UsageError("--size " + text + ": expected W or WxH, 1..16384 pixels");
@@ -67,14 +73,22 @@ Eigen::Vector2i parse_size(const std::string& text) {
 }
 
 int write_emblem(const RenderArgs& args) {
-  if (!args.meshes.empty()) throw UsageError("--emblem takes no mesh files");
+  if (!args.meshes.empty()) {
+    throw UsageError("--emblem takes no mesh files");
+  }
   const Eigen::Vector2i size =
       args.size.empty() ? Eigen::Vector2i(512, 512) : parse_size(args.size);
-  if (size.x() != size.y()) throw UsageError("--size " + args.size + ": the emblem is square");
-  if (size.x() < 8 || size.x() > 8192) throw UsageError("--size: the emblem is 8..8192 pixels");
+  if (size.x() != size.y()) {
+    throw UsageError("--size " + args.size + ": the emblem is square");
+  }
+  if (size.x() < 8 || size.x() > 8192) {
+    throw UsageError("--size: the emblem is 8..8192 pixels");
+  }
   require_extension(args.emblem, {".png"}, "--emblem");
   write_png(args.emblem, make_emblem(size.x()));  // transparent outside the ring
-  if (!args.quiet) std::cout << args.emblem << ": emblem " << size.x() << " x " << size.y() << '\n';
+  if (!args.quiet) {
+    std::cout << args.emblem << ": emblem " << size.x() << " x " << size.y() << '\n';
+  }
   return kOk;
 }
 
@@ -83,7 +97,12 @@ int write_emblem(const RenderArgs& args) {
 SceneObject load_object(const std::string& path, const RenderArgs& args,
                         std::vector<std::string>& warnings) {
   MeshReadResult read = read_mesh(path);
-  for (const std::string& w : read.warnings) warnings.push_back(path + ": " + w);
+  for (const std::string& w : read.warnings) {
+    std::string line = path;
+    line += ": ";
+    line += w;
+    warnings.push_back(std::move(line));
+  }
   SceneObject object{std::move(read.mesh), {}};
   if (object.mesh.has_texcoords() && !object.mesh.materials.empty()) {
     MaterialTextures textures = load_material_textures(
@@ -95,8 +114,12 @@ SceneObject load_object(const std::string& path, const RenderArgs& args,
 }
 
 int run_render(const RenderArgs& args) {
-  if (!args.emblem.empty()) return write_emblem(args);
-  if (args.meshes.empty()) throw UsageError("render: give at least one MESH (or --emblem OUT.png)");
+  if (!args.emblem.empty()) {
+    return write_emblem(args);
+  }
+  if (args.meshes.empty()) {
+    throw UsageError("render: give at least one MESH (or --emblem OUT.png)");
+  }
   require_flag(args.out, "--out");
   require_extension(args.out, {".png"}, "--out");
   const Eigen::Vector2i size =
@@ -129,8 +152,12 @@ int run_render(const RenderArgs& args) {
   Eigen::Vector3d view;
   if (!args.view.empty()) {
     view = parse_point(args.view, "--view");
-    if (!(view.norm() > 0.0)) throw UsageError("--view: the direction is zero");
-    if (args.angles) view = orbit_view(view, args.azimuth, args.elevation, up);
+    if (!(view.norm() > 0.0)) {
+      throw UsageError("--view: the direction is zero");
+    }
+    if (args.angles) {
+      view = orbit_view(view, args.azimuth, args.elevation, up);
+    }
   } else if (args.angles) {
     view = view_from_angles(args.azimuth, args.elevation, up);
   } else {
