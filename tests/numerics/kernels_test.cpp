@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 #include <tbb/task_arena.h>
 
+#include <Eigen/Eigenvalues>
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseLU>
 #include <algorithm>
@@ -146,13 +147,7 @@ TEST(Bicgstab, NonsymmetricSolveMatchesTheSparseLu) {
   const Eigen::VectorXd exact = lu.solve(b);
 
   // Preconditioned by AMG on the symmetrised operator (as the mean-value disk map does).
-  Eigen::SparseMatrix<double> s = 0.5 * (a + Eigen::SparseMatrix<double>(a.transpose()));
-  const Eigen::VectorXd ones = Eigen::VectorXd::Ones(a.rows());
-  const Eigen::VectorXd fix = a * ones - s * ones;
-  for (Eigen::Index i = 0; i < a.rows(); ++i) {
-    s.coeffRef(i, i) += fix[i];
-  }
-  const Multigrid multigrid(s);
+  const Multigrid multigrid(symmetrised_laplacian(a));
   const LinearOperator apply = [&](const Eigen::VectorXd& v, Eigen::VectorXd& out) { out = a * v; };
   const LinearOperator precondition = [&](const Eigen::VectorXd& v, Eigen::VectorXd& out) {
     out = multigrid.apply(v);
@@ -181,6 +176,27 @@ TEST(Bicgstab, NonsymmetricSolveMatchesTheSparseLu) {
   EXPECT_FALSE(short_run.converged);
   EXPECT_LE(short_run.iterations, 3);
   EXPECT_NEAR(short_run.relative_residual, (b - a * w).norm() / b.norm(), 1e-12);
+}
+
+// The symmetrised Laplacian of a small nonsymmetric M-matrix, written out by hand: off-diagonals
+// the mean of a_ij and a_ji, each row summing to A's row sum.
+TEST(SymmetrisedLaplacian, AveragesTheOffDiagonalsAndKeepsTheRowSums) {
+  Eigen::MatrixXd a(3, 3);
+  a << 5.0, -1.0, -3.0,  // row sum 1
+      -2.0, 4.0, -2.0,   // row sum 0
+      -1.0, -1.0, 3.0;   // row sum 1
+  Eigen::MatrixXd expected(3, 3);
+  expected << 0.0, -1.5, -2.0,  //
+      -1.5, 0.0, -1.5,          //
+      -2.0, -1.5, 0.0;
+  expected(0, 0) = 1.0 + 3.5;
+  expected(1, 1) = 0.0 + 3.0;
+  expected(2, 2) = 1.0 + 3.5;
+  const Eigen::MatrixXd p = Eigen::MatrixXd(symmetrised_laplacian(a.sparseView()));
+  EXPECT_LT((p - expected).cwiseAbs().maxCoeff(), 1e-15);
+  // (A + A^T) / 2 would have row 0 summing to 5 - 1.5 - 2 = 1.5 and row 1 to 4 - 1.5 - 1.5 = 1, row
+  // 2 to 3 - 2 - 1.5 = -0.5 < 0: the fix matters.
+  EXPECT_GT(Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(p).eigenvalues().minCoeff(), 0.0);
 }
 
 TEST(Bicgstab, IteratesAreTheSameOnOneAndManyThreads) {

@@ -69,4 +69,15 @@ Eigen::SparseMatrix<double> graph_laplacian(const GraphAdjacency& graph,
   return matrix;
 }
 
+Eigen::SparseMatrix<double> symmetrised_laplacian(const Eigen::SparseMatrix<double>& a) {
+  const Eigen::VectorXd ones = Eigen::VectorXd::Ones(a.cols());
+  const Eigen::VectorXd row_sums = a * ones;
+  Eigen::SparseMatrix<double> p = 0.5 * (a + Eigen::SparseMatrix<double>(a.transpose()));
+  const Eigen::VectorXd p_sums = p * ones;
+  for (Eigen::Index i = 0; i < p.rows(); ++i) {
+    p.coeffRef(i, i) += row_sums[i] - p_sums[i];
+  }
+  return p;
+}
+
 }  // namespace elastic

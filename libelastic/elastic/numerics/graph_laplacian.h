@@ -29,4 +29,14 @@ Eigen::SparseMatrix<double> graph_laplacian(const GraphAdjacency& graph,
                                             const std::vector<int>& free_index,
                                             const std::function<double(int, int)>& weight);
 
+/// The symmetric counterpart of a nonsymmetric Laplacian-like M-matrix A (positive diagonal,
+/// off-diagonals <= 0, rows summing to >= 0, e.g. mean-value weights with Dirichlet boundary
+/// rows): off-diagonal (a_ij + a_ji) / 2, diagonal chosen so that every row sums to A's row sum.
+/// It is then a weakly diagonally dominant symmetric M-matrix, positive definite when A's rows
+/// reach a positive row sum through the graph, and a preconditioner for A (e.g. one multigrid
+/// V-cycle of it for BiCGSTAB) that differs from A only by the weights' asymmetry. The plain
+/// symmetric part (A + A^T) / 2 would not do: its rows sum to sum_j (a_ji - a_ij) / 2 more than
+/// A's, which can make them negative and the matrix indefinite.
+Eigen::SparseMatrix<double> symmetrised_laplacian(const Eigen::SparseMatrix<double>& a);
+
 }  // namespace elastic

@@ -13,6 +13,7 @@
 
 #include "elastic/core/error.h"
 #include "elastic/numerics/bicgstab.h"
+#include "elastic/numerics/graph_laplacian.h"
 #include "elastic/numerics/multigrid.h"
 
 namespace elastic {
@@ -77,29 +78,20 @@ Eigen::MatrixXd solve_mean_value_lu(const Eigen::SparseMatrix<double>& a,
 /// 28,561-vertex hemisphere.off (5,775 particles, 2 threads). Above
 /// kIterativeMeanValueSize unknowns it is solved instead by BiCGSTAB (numerics/bicgstab.h) to a
 /// relative residual of 1e-12, preconditioned by one AMG V-cycle (numerics/multigrid.h) on the
-/// symmetrised Laplacian P: off-diagonal -(w_ij + w_ji) / 2, diagonal chosen so that P's rows sum
-/// to A's. P is then a weakly diagonally dominant symmetric M-matrix tied to the boundary, hence
-/// positive definite, and it differs from A only by the asymmetry of the weights, which is small on
-/// a well-shaped mesh. The plain symmetric part (A + A^T) / 2 would not do: its rows sum to
-/// sum_j (w_ij - w_ji) / 2, which can be negative, so it need not be definite. A system the
-/// iteration does not solve falls back to the sparse LU. On the hemisphere BiCGSTAB takes 9
-/// iterations per coordinate and the naive map 0.22 s.
+/// symmetrised Laplacian (numerics/graph_laplacian.h `symmetrised_laplacian`: off-diagonal
+/// -(w_ij + w_ji) / 2, rows summing to A's), positive definite since the region's vertices reach
+/// its boundary, and close to A where the weights are nearly symmetric (a well-shaped mesh). A
+/// system the iteration does not solve falls back to the sparse LU. On the hemisphere BiCGSTAB
+/// takes 9 iterations per coordinate and the naive map 0.22 s.
 Eigen::MatrixXd solve_mean_value(const Eigen::SparseMatrix<double>& a, const Eigen::MatrixXd& rhs,
                                  const std::string& name) {
   const Eigen::Index n = a.rows();
   if (n < kIterativeMeanValueSize) {
     return solve_mean_value_lu(a, rhs, name);
   }
-  const Eigen::VectorXd ones = Eigen::VectorXd::Ones(n);
-  const Eigen::VectorXd row_sums = a * ones;
-  Eigen::SparseMatrix<double> p = 0.5 * (a + Eigen::SparseMatrix<double>(a.transpose()));
-  const Eigen::VectorXd p_sums = p * ones;
-  for (Eigen::Index i = 0; i < n; ++i) {
-    p.coeffRef(i, i) += row_sums[i] - p_sums[i];
-  }
   std::optional<Multigrid> multigrid;
   try {
-    multigrid.emplace(p);
+    multigrid.emplace(symmetrised_laplacian(a));
   } catch (const Error&) {
     return solve_mean_value_lu(a, rhs, name);  // e.g. an unknown without weights: LU says why
   }
