@@ -213,6 +213,20 @@ TEST(Grammar, VersionTakesAJobFileLikeEverySubcommand) {
                         "other.json");
 }
 
+// The allocator the tool was linked with is the one serving malloc, and says so (allocator.h).
+TEST(Grammar, VersionNamesTheAllocatorServingMalloc) {
+  const fs::path dir = test::scratch_dir("grammar_allocator");
+  const CliRun run = elastic("version", dir);
+  ASSERT_EQ(run.code, 0) << run.err;
+  EXPECT_NE(run.out.find("kernel thp: "), std::string::npos) << run.out;
+  if (ELASTIC_CLI_JEMALLOC) {
+    EXPECT_NE(run.out.find("allocator: jemalloc "), std::string::npos) << run.out;
+    EXPECT_NE(run.out.find("(thp:always)"), std::string::npos) << run.out;
+  } else {
+    EXPECT_NE(run.out.find("allocator: glibc malloc"), std::string::npos) << run.out;
+  }
+}
+
 TEST(Grammar, ReportKeysAreNamedOneWayAndDocumented) {
   const fs::path dir = test::scratch_dir("grammar_keys");
   ASSERT_EQ(elastic("sample -q --source " + mesh("plane_quads.obj") +

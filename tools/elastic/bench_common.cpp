@@ -11,6 +11,7 @@
 #include <sstream>
 #include <thread>
 
+#include "allocator.h"
 #include "elastic/core/atomic_file.h"
 #include "elastic/core/error.h"
 #include "map_job.h"
@@ -44,6 +45,7 @@ nlohmann::json machine_json(int solver_threads) {
   return {{"cpu", cpu_model()},
           {"threads", std::thread::hardware_concurrency()},
           {"solver_threads", solver_threads},
+          {"allocator", allocator_description()},
           {"date", utc_now()}};
 }
 

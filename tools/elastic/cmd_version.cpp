@@ -1,6 +1,7 @@
 // `elastic version`: library and dependency versions, for bug reports.
 #include <iostream>
 
+#include "allocator.h"
 #include "command.h"
 
 ELASTIC_COMMAND("version", "Print the version of elastic", [](CLI::App& sub) {
@@ -11,7 +12,8 @@ ELASTIC_COMMAND("version", "Print the version of elastic", [](CLI::App& sub) {
   static bool quiet = false;
   sub.add_flag("-q,--quiet", quiet, "Accepted as everywhere (the version is still printed)");
   return [] {
-    std::cout << "elastic " << ELASTIC_VERSION << '\n';
+    std::cout << "elastic " << ELASTIC_VERSION << '\n'
+              << "allocator: " << elastic::cli::allocator_description() << '\n';
     return 0;
   };
 });

@@ -1,0 +1,21 @@
+#pragma once
+// The `elastic` tool's memory allocator, chosen at link time (tools/elastic/CMakeLists.txt).
+//
+// With jemalloc (ELASTIC_WITH_JEMALLOC, the default where libjemalloc is installed, never under the
+// sanitizers) every arena is advised to use transparent huge pages. Why: a map touches its memory
+// once and the kernel faults each fresh 4 KiB page in separately; on virtual machines a fault
+// costs several microseconds, and the 5,775-particle grid.off -> hemisphere.off map took 22,600 of
+// them (about a quarter of its wall time) under glibc's malloc. With 2 MiB pages it takes a few
+// hundred. The library itself never chooses an allocator: a program that links it (the Python
+// module, a user's tool) keeps its own.
+
+#include <string>
+
+namespace elastic::cli {
+
+/// The allocator serving malloc, its huge-page option and the kernel's huge-page mode, e.g.
+/// "jemalloc 5.3.0-0-g54eaed1... (thp:always), kernel thp: madvise" or "glibc malloc, kernel thp:
+/// madvise": printed by `elastic version` and written into every benchmark's `machine`.
+std::string allocator_description();
+
+}  // namespace elastic::cli
