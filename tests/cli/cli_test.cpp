@@ -285,6 +285,33 @@ TEST(Cli, BenchWarmMapsEveryStepColdAndWarm) {
   expect_error(elastic("bench warm -q --target-region boundary", dir), 65, "disk");
 }
 
+// `bench scale` at one small size (the command, not its figures): each timed run is an `elastic
+// map` of its own (`process` is its whole wall time, so at least the report's `total`), beside
+// CGAL's LSCM on the same grid; a missing mesh fails with the map's own message and code.
+TEST(Cli, BenchScaleTimesWholeProcessesBesideLscm) {
+  const fs::path dir = test::scratch_dir("cli_bench_scale");
+  const CliRun run = elastic(
+      "bench scale -q --sizes 300 --runs 2 --threads 2 --report " + (dir / "s.json").string(), dir);
+  ASSERT_EQ(run.code, 0) << run.err;
+  const nlohmann::json report = nlohmann::json::parse(std::ifstream(dir / "s.json"));
+  ASSERT_EQ(report["sizes"].size(), 1u);
+  const nlohmann::json& size = report["sizes"][0];
+  const nlohmann::json& t = size["seconds"];
+  EXPECT_NEAR(size["particles"].get<double>(), 300.0, 30.0);
+  EXPECT_EQ(size["folds"], 0);
+  EXPECT_TRUE(size["converged"].get<bool>());
+  EXPECT_GT(t["total"].get<double>(), 0.0);
+  EXPECT_GE(t["process"].get<double>(), t["total"].get<double>());
+  EXPECT_GE(t["total"].get<double>(), t["loading"].get<double>() + t["solve"].get<double>());
+  EXPECT_GT(t["lscm"].get<double>(), 0.0);
+  EXPECT_DOUBLE_EQ(size["ratio"].get<double>(),
+                   t["process"].get<double>() / t["lscm"].get<double>());
+  EXPECT_NE(report["machine"]["allocator"].get<std::string>(), "");
+  expect_error(
+      elastic("bench scale -q --sizes 300 --runs 1 --source " + (dir / "nope.obj").string(), dir),
+      66, "nope.obj");
+}
+
 // `bench robustness` on two tiny cases (the command, not its figures): one that runs, one whose
 // region cannot be built. Every case carries a boolean `pass`; the running case's checks are
 // recomputed here from its reported figures by the documented criteria (docs/results.md).
