@@ -13,12 +13,19 @@
 // jemalloc reads this global before its first allocation (its documented compile-time
 // configuration; the MALLOC_CONF environment variable still overrides it):
 // - thp:always advises every arena with MADV_HUGEPAGE, which is what the kernel's default
-//   transparent-huge-page mode ("madvise") waits for;
-// - metadata_thp:auto lets its own bookkeeping use huge pages once it grows.
-// Freed memory is kept for reuse (jemalloc's default decay of 10 s), so a map's later stages do
-// not fault in what the earlier ones freed.
+//   transparent-huge-page mode ("madvise") waits for; metadata_thp:auto lets jemalloc's own
+//   bookkeeping use huge pages once it grows;
+// - dirty_decay_ms:-1 and muzzy_decay_ms:-1 keep freed pages for reuse instead of returning them
+//   to the kernel over the next seconds (and faulting them in again): a command runs one job and
+//   exits, and `elastic studio` keeps what its largest map needed until it exits;
+// - narenas:1: one arena for every thread. The studio answers each request on whichever HTTP
+//   thread is free, and with an arena per thread each one faulted its memory in afresh.
+// Measured (2 cores, farm-bench medians, against the same build on glibc's malloc): the
+// 5,775-particle grid.off -> hemisphere.off map 0.68x the wall time, with 94 MiB peak instead
+// of 74; the studio's live update (2,000 particles) 0.131-0.137 s instead of 0.118-0.124.
 // NOLINTNEXTLINE(cppcoreguidelines-avoid-non-const-global-variables)
-const char* malloc_conf = "thp:always,metadata_thp:auto";
+const char* malloc_conf =
+    "thp:always,metadata_thp:auto,dirty_decay_ms:-1,muzzy_decay_ms:-1,narenas:1";
 #endif
 
 namespace elastic::cli {

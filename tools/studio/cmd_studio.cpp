@@ -45,7 +45,8 @@ int run_studio(StudioArgs& args) {
   // arena was cold). Measured on the live drag (spot -> bob, 2,000 particles, 2 cores): the
   // region cut took 0.085 s on the first 8 updates and 0.04 s afterwards, and a whole update
   // 0.157 s median; with one arena the cut takes 0.043 s from the first update and the update
-  // 0.131 s.
+  // 0.131 s. A tool linked with jemalloc ignores this and has one arena anyway
+  // (tools/elastic/allocator.cpp, narenas:1).
   mallopt(M_ARENA_MAX, 1);
 #endif
   StudioOptions options = args.options;
