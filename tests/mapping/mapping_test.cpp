@@ -10,8 +10,11 @@
 #include <memory>
 #include <random>
 #include <set>
+#include <string>
 #include <utility>
+#include <vector>
 
+#include "elastic/core/error.h"
 #include "elastic/mapping/map_regions.h"
 #include "elastic/regions/region_spec.h"
 #include "elastic/shapes/procedural_shapes.h"
@@ -288,6 +291,28 @@ TEST_F(MappingTest, OutsideTheRegionIsOutsideAndTheGridEdgeIsInside) {
   EXPECT_EQ(outside + clamped, checked);
   RecordProperty("outside_beyond_edge", outside);
   RecordProperty("clamped_beyond_edge", clamped);
+}
+
+// A particle whose target point lies outside the target region is refused by the lowest such
+// index, whatever the thread count (the constructor's loop runs in parallel).
+TEST_F(MappingTest, ParticleOutsideTheTargetRegionIsNamedByItsLowestIndex) {
+  const MapResult& result = pair_->cap_to_plane;  // target: the plane's disk of radius 0.6
+  const int n = result.sampling.grid.num_particles();
+  ASSERT_GT(n, 250);
+  std::vector<SurfacePoint> points = result.relaxation.points;
+  const SurfacePoint outside = pair_->plane.closest(Eigen::Vector3d(0.9, 0.9, 0.0)).point;
+  points[static_cast<std::size_t>(n - 1)] = outside;
+  points[static_cast<std::size_t>(n / 2)] = outside;
+  points[7] = outside;
+  try {
+    const Mapping mapping(result.sampling.grid, pair_->cap, *result.source_disk, pair_->plane,
+                          *result.target_disk, points);
+    FAIL() << "a target point outside the region was accepted";
+  } catch (const NumericalError& e) {
+    EXPECT_NE(std::string(e.what()).find("particle 7 is outside the target region"),
+              std::string::npos)
+        << e.what();
+  }
 }
 
 }  // namespace
