@@ -73,6 +73,20 @@ TEST(Cli, MissingAndMalformedFilesNameTheFile) {
       elastic("map --source " + (dir / "nan.obj").string() + " --target " + mesh("cap_quads.obj"),
               dir),
       65, "nan.obj");
+  // The two sides load at once (map_job.cpp load_sides), and still the source's error is the one
+  // reported when both fail, every time; a bad target alone is named too.
+  for (int run = 0; run < 5; ++run) {
+    expect_error(elastic("map --source " + (dir / "nan.obj").string() + " --target " +
+                             (dir / "broken.obj").string(),
+                         dir),
+                 65, "nan.obj");
+  }
+  expect_error(elastic("map --source " + mesh("plane_quads.obj") +
+                           " --source-region "
+                           "disk:0,0,0,0.5 --target " +
+                           (dir / "broken.obj").string(),
+                       dir),
+               65, "broken.obj");
 }
 
 TEST(Cli, NonManifoldMeshIsRefusedByName) {

@@ -1,8 +1,11 @@
 #include "map_job.h"
 
+#include <tbb/parallel_invoke.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <exception>
 #include <fstream>
 #include <iostream>
 #include <optional>
@@ -247,6 +250,88 @@ std::string image_surface_key(const std::string& path, double width, const std::
   return "image|" + path + "|" + std::to_string(width) + "|" + scheme;
 }
 
+namespace {
+
+// Loads both sides of the job into `s`: each surface (read, repaired, limit surface, projector)
+// and its region (the target's only for a drawn region, not for --target-place). Without a cache
+// the two sides load at once, as nothing of one depends on the other (spot.obj -> bob_tri.obj,
+// 2,000 particles, 2 threads: the whole `elastic map` 0.63 -> 0.53 s, farm-bench medians). With a
+// cache (shared by the two sides) they load one after the other.
+// Errors and warnings come out as if loaded in order: the source's first.
+void load_sides(const MapJob& job, MapSession& s, std::optional<MeshReadResult> target_read,
+                SurfaceCache* cache) {
+  // A surface from the cache, or loaded (and then cached).
+  const auto surface = [&](const std::string& key, const auto& load) {
+    if (cache == nullptr) {
+      return load();
+    }
+    const auto found = cache->find(key);
+    if (found != cache->end()) {
+      return found->second;
+    }
+    return cache->emplace(key, load()).first->second;
+  };
+  std::exception_ptr source_error, target_error;
+  const auto load_source = [&] {
+    try {
+      s.source =
+          s.image ? surface(image_surface_key(job.source_image, job.image_width, job.scheme),
+                            [&] {
+                              return surface_from_mesh(s.image->mesh, job.source_image, job.scheme);
+                            })
+                  : surface(mesh_surface_key(job.source, job.scheme),
+                            [&] { return load_surface(job.source, job.scheme); });
+      RegionSpec spec =
+          s.image ? s.image->region : parse_region_flag(job.source_region, "--source-region");
+      if (!job.source_anchor.empty()) {
+        spec.anchor = parse_point(job.source_anchor, "--source-anchor");
+      }
+      s.source_region = make_region(*s.source.projector, spec, {.name = "--source-region"});
+    } catch (...) {
+      source_error = std::current_exception();
+    }
+  };
+  const auto load_target = [&] {
+    try {
+      s.target = surface(mesh_surface_key(job.target, job.scheme), [&] {
+        if (!target_read) {
+          return load_surface(job.target, job.scheme);
+        }
+        LoadedSurface loaded =
+            surface_from_mesh(std::move(target_read->mesh), job.target, job.scheme);
+        loaded.warnings.insert(loaded.warnings.begin(), target_read->warnings.begin(),
+                               target_read->warnings.end());
+        return loaded;
+      });
+      if (job.target_place.empty()) {
+        RegionSpec spec = parse_region_flag(job.target_region, "--target-region");
+        if (!job.target_anchor.empty()) {
+          spec.anchor = parse_point(job.target_anchor, "--target-anchor");
+        }
+        s.target_region = make_region(*s.target.projector, spec, {.name = "--target-region"});
+      }
+    } catch (...) {
+      target_error = std::current_exception();
+    }
+  };
+  if (cache == nullptr) {
+    tbb::parallel_invoke(load_source, load_target);
+  } else {
+    load_source();
+    load_target();
+  }
+  if (source_error) {
+    std::rethrow_exception(source_error);
+  }
+  print_warnings(s.source.warnings, job.quiet);
+  if (target_error) {
+    std::rethrow_exception(target_error);
+  }
+  print_warnings(s.target.warnings, job.quiet);
+}
+
+}  // namespace
+
 std::unique_ptr<MapSession> run_map_job(const MapJob& job, const ProgressCallback& progress,
                                         const FrameCallback& frame, long frame_interval,
                                         SurfaceCache* cache) {
@@ -307,41 +392,7 @@ std::unique_ptr<MapSession> run_map_job(const MapJob& job, const ProgressCallbac
   if (progress) {
     progress({.stage = "load"});
   }
-  // A surface from the cache, or loaded (and then cached).
-  const auto surface = [&](const std::string& key, const auto& load) {
-    if (cache == nullptr) {
-      return load();
-    }
-    const auto found = cache->find(key);
-    if (found != cache->end()) {
-      return found->second;
-    }
-    return cache->emplace(key, load()).first->second;
-  };
-  s.source =
-      s.image
-          ? surface(image_surface_key(job.source_image, job.image_width, job.scheme),
-                    [&] { return surface_from_mesh(s.image->mesh, job.source_image, job.scheme); })
-          : surface(mesh_surface_key(job.source, job.scheme),
-                    [&] { return load_surface(job.source, job.scheme); });
-  print_warnings(s.source.warnings, job.quiet);
-  s.target = surface(target_key, [&] {
-    if (!target_read) {
-      return load_surface(job.target, job.scheme);
-    }
-    LoadedSurface loaded = surface_from_mesh(std::move(target_read->mesh), job.target, job.scheme);
-    loaded.warnings.insert(loaded.warnings.begin(), target_read->warnings.begin(),
-                           target_read->warnings.end());
-    return loaded;
-  });
-  print_warnings(s.target.warnings, job.quiet);
-
-  RegionSpec source_spec =
-      s.image ? s.image->region : parse_region_flag(job.source_region, "--source-region");
-  if (!job.source_anchor.empty()) {
-    source_spec.anchor = parse_point(job.source_anchor, "--source-anchor");
-  }
-  s.source_region = make_region(*s.source.projector, source_spec, {.name = "--source-region"});
+  load_sides(job, s, std::move(target_read), cache);
   MapOptions options = make_map_options(job, progress);
   options.relaxation.frame = frame;
   options.relaxation.frame_interval = std::max(1L, frame_interval);
@@ -349,11 +400,6 @@ std::unique_ptr<MapSession> run_map_job(const MapJob& job, const ProgressCallbac
     s.seconds_loading = seconds_since(start);
     run_decal(job, options, s);
   } else {
-    RegionSpec target_spec = parse_region_flag(job.target_region, "--target-region");
-    if (!job.target_anchor.empty()) {
-      target_spec.anchor = parse_point(job.target_anchor, "--target-anchor");
-    }
-    s.target_region = make_region(*s.target.projector, target_spec, {.name = "--target-region"});
     s.seconds_loading = seconds_since(start);
     s.result = map_regions(*s.source.projector, s.source_region, *s.target.projector,
                            s.target_region, options);
