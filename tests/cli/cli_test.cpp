@@ -321,6 +321,10 @@ TEST(Cli, BenchScaleTimesWholeProcessesBesideLscm) {
   EXPECT_DOUBLE_EQ(size["ratio"].get<double>(),
                    t["process"].get<double>() / t["lscm"].get<double>());
   EXPECT_NE(report["machine"]["allocator"].get<std::string>(), "");
+  // The map process's peak: more than the tool's own code and libraries (about 20 MiB), far less
+  // than a gigabyte at 300 particles.
+  EXPECT_GT(size["peak_mib"].get<double>(), 10.0);
+  EXPECT_LT(size["peak_mib"].get<double>(), 1024.0);
   expect_error(
       elastic("bench scale -q --sizes 300 --runs 1 --source " + (dir / "nope.obj").string(), dir),
       66, "nope.obj");

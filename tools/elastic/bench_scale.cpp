@@ -2,6 +2,7 @@
 
 #include <fcntl.h>
 #include <spawn.h>
+#include <sys/resource.h>
 #include <sys/wait.h>
 #include <tbb/task_arena.h>
 #include <unistd.h>
@@ -67,12 +68,17 @@ Region target_grid_region(const MapSession& session) {
   return region;
 }
 
+// What the operating system measured of one map's process.
+struct ProcessFigures {
+  double wall = 0.0;      ///< seconds from spawn to exit (loading of the shared libraries included)
+  double peak_mib = 0.0;  ///< largest resident set, MiB (the kernel's ru_maxrss)
+};
+
 // One `elastic map` of the job in a process of its own, as a user runs it: this binary again
 // (/proc/self/exe), nothing shared with this process (its page cache aside). Returns the child's
-// report and sets `wall` to the whole process's seconds, from spawn to exit, loading of the shared
-// libraries and writing of the report included. \throws NumericalError when the map fails.
+// report and fills `figures`. \throws NumericalError when the map fails.
 nlohmann::json map_in_own_process(const ScaleArgs& args, long particles,
-                                  const std::filesystem::path& report, double& wall) {
+                                  const std::filesystem::path& report, ProcessFigures& figures) {
   namespace fs = std::filesystem;
   std::error_code error;
   const fs::path exe = fs::read_symlink("/proc/self/exe", error);
@@ -113,9 +119,11 @@ nlohmann::json map_in_own_process(const ScaleArgs& args, long particles,
     throw IoError(exe.string(), std::string("cannot start the map: ") + std::strerror(spawned));
   }
   int status = 0;
-  while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+  rusage usage{};
+  while (wait4(pid, &status, 0, &usage) < 0 && errno == EINTR) {
   }
-  wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  figures.wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  figures.peak_mib = static_cast<double>(usage.ru_maxrss) / 1024.0;  // ru_maxrss is in KiB
   if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
     const std::string how = WIFEXITED(status)
                                 ? "exited with code " + std::to_string(WEXITSTATUS(status))
@@ -146,7 +154,7 @@ nlohmann::json run_size(long particles, const ScaleArgs& args) {
   job.threads = args.threads;
   job.quiet = true;
   nlohmann::json out = {{"requested_particles", particles}};
-  std::vector<double> process, total, loading, sampling, naive, solve, lscm;
+  std::vector<double> process, peak, total, loading, sampling, naive, solve, lscm;
   {
     const std::unique_ptr<MapSession> s = run_map_job(job);
     const Region grid = target_grid_region(*s);
@@ -164,10 +172,11 @@ nlohmann::json run_size(long particles, const ScaleArgs& args) {
     if (!args.quiet) {
       std::cerr << "elastic bench scale: " << particles << " particles, run " << run + 1 << '\n';
     }
-    double wall = 0.0;
-    const nlohmann::json r = map_in_own_process(args, particles, report, wall);
+    ProcessFigures figures;
+    const nlohmann::json r = map_in_own_process(args, particles, report, figures);
     const nlohmann::json& t = r["seconds"];
-    process.push_back(wall);
+    process.push_back(figures.wall);
+    peak.push_back(figures.peak_mib);
     total.push_back(t.value("total", 0.0));
     loading.push_back(t.value("loading", 0.0));
     sampling.push_back(t.value("sampling", 0.0));
@@ -182,6 +191,7 @@ nlohmann::json run_size(long particles, const ScaleArgs& args) {
                     {"loading", median(loading)}, {"sampling", median(sampling)},
                     {"naive_map", median(naive)}, {"solve", median(solve)},
                     {"lscm", median(lscm)}};
+  out["peak_mib"] = median(peak);
   out["ratio"] = median(process) / median(lscm);
   return out;
 }
@@ -202,15 +212,15 @@ int run_scale(const ScaleArgs& args, const CLI::App& sub) {
   });
   std::ostringstream table;
   table << "| particles | process | total | loading | sampling | naive map | solve | CGAL LSCM | "
-           "ratio |\n"
-        << "|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+           "ratio | peak MiB |\n"
+        << "|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
   for (const nlohmann::json& c : report["sizes"]) {
     const nlohmann::json& t = c["seconds"];
     const auto d = [](const nlohmann::json& v) { return v.get<double>(); };
     table << std::setprecision(3) << "| " << c["particles"] << " | " << d(t["process"]) << " | "
           << d(t["total"]) << " | " << d(t["loading"]) << " | " << d(t["sampling"]) << " | "
           << d(t["naive_map"]) << " | " << d(t["solve"]) << " | " << d(t["lscm"]) << " | "
-          << d(c["ratio"]) << " |\n";
+          << d(c["ratio"]) << " | " << d(c["peak_mib"]) << " |\n";
   }
   write_report(args.report, report);
   std::cout << table.str();
@@ -239,7 +249,8 @@ std::function<int()> add_scale_subcommand(CLI::App& bench) {
       "Example:\n  elastic bench scale --sizes 5775,25000 --runs 3 --report scale.json\n"
       "Each run is a whole `elastic map` in its own process. Times are medians of --runs:\n"
       "`process` from its start to its exit, the others its report's `seconds`; `ratio` is\n"
-      "`process` over CGAL LSCM's parameterize call on the same grid.");
+      "`process` over CGAL LSCM's parameterize call on the same grid; `peak MiB` the map\n"
+      "process's largest resident set.");
   return [a, sub] { return run_scale(*a, *sub); };
 }
 
