@@ -27,8 +27,6 @@
 #include "job_file.h"
 #include "map_job.h"
 
-extern char** environ;  // NOLINT(readability-redundant-declaration): POSIX declares it nowhere
-
 namespace elastic::cli {
 namespace {
 
@@ -168,6 +166,12 @@ nlohmann::json run_size(long particles, const ScaleArgs& args) {
   const std::filesystem::path report =
       std::filesystem::temp_directory_path() /
       ("elastic-bench-scale-" + std::to_string(::getpid()) + ".json");
+  // The children's report file goes when this size is done, also when a run fails.
+  const std::unique_ptr<const std::filesystem::path, void (*)(const std::filesystem::path*)>
+      remove_report(&report, [](const std::filesystem::path* path) {
+        std::error_code ignored;
+        std::filesystem::remove(*path, ignored);
+      });
   for (int run = 0; run < args.runs; ++run) {
     if (!args.quiet) {
       std::cerr << "elastic bench scale: " << particles << " particles, run " << run + 1 << '\n';
@@ -186,7 +190,6 @@ nlohmann::json run_size(long particles, const ScaleArgs& args) {
     out["converged"] = r.value("converged", false);
     out["folds"] = r.value("folds", -1);
   }
-  std::filesystem::remove(report);
   out["seconds"] = {{"process", median(process)}, {"total", median(total)},
                     {"loading", median(loading)}, {"sampling", median(sampling)},
                     {"naive_map", median(naive)}, {"solve", median(solve)},

@@ -252,6 +252,15 @@ std::string image_surface_key(const std::string& path, double width, const std::
 
 namespace {
 
+// One side's region from its spec and its --<side>-anchor flag (side: "source" or "target").
+Region side_region(const SurfaceProjector& projector, RegionSpec spec, const std::string& anchor,
+                   const std::string& side) {
+  if (!anchor.empty()) {
+    spec.anchor = parse_point(anchor, "--" + side + "-anchor");
+  }
+  return make_region(projector, spec, {.name = "--" + side + "-region"});
+}
+
 // Loads both sides of the job into `s`: each surface (read, repaired, limit surface, projector)
 // and its region (the target's only for a drawn region, not for --target-place). Without a cache
 // the two sides load at once, as nothing of one depends on the other (spot.obj -> bob_tri.obj,
@@ -281,12 +290,10 @@ void load_sides(const MapJob& job, MapSession& s, std::optional<MeshReadResult> 
                             })
                   : surface(mesh_surface_key(job.source, job.scheme),
                             [&] { return load_surface(job.source, job.scheme); });
-      RegionSpec spec =
-          s.image ? s.image->region : parse_region_flag(job.source_region, "--source-region");
-      if (!job.source_anchor.empty()) {
-        spec.anchor = parse_point(job.source_anchor, "--source-anchor");
-      }
-      s.source_region = make_region(*s.source.projector, spec, {.name = "--source-region"});
+      s.source_region = side_region(
+          *s.source.projector,
+          s.image ? s.image->region : parse_region_flag(job.source_region, "--source-region"),
+          job.source_anchor, "source");
     } catch (...) {
       source_error = std::current_exception();
     }
@@ -304,11 +311,9 @@ void load_sides(const MapJob& job, MapSession& s, std::optional<MeshReadResult> 
         return loaded;
       });
       if (job.target_place.empty()) {
-        RegionSpec spec = parse_region_flag(job.target_region, "--target-region");
-        if (!job.target_anchor.empty()) {
-          spec.anchor = parse_point(job.target_anchor, "--target-anchor");
-        }
-        s.target_region = make_region(*s.target.projector, spec, {.name = "--target-region"});
+        s.target_region = side_region(*s.target.projector,
+                                      parse_region_flag(job.target_region, "--target-region"),
+                                      job.target_anchor, "target");
       }
     } catch (...) {
       target_error = std::current_exception();
