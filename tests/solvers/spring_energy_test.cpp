@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 #include <cmath>
 #include <random>
@@ -201,6 +202,98 @@ TEST(SpringEnergy, BarrierSeenAlongTheNormals) {
   up.row(2).setOnes();
   EXPECT_TRUE(std::isfinite(system.evaluate(standing).barrier));
   EXPECT_TRUE(std::isinf(system.evaluate(standing, nullptr, &up).barrier));
+}
+
+// The identity basis of every particle: SpringSystem::hessian then is the full 3P x 3P Hessian.
+SpringSystem::HessianBasis full_basis(Eigen::Index particles) {
+  SpringSystem::HessianBasis basis;
+  basis.first.resize(static_cast<std::size_t>(particles));
+  basis.count.assign(static_cast<std::size_t>(particles), 3);
+  basis.vectors = Eigen::Matrix3Xd::Zero(3, 3 * particles);
+  for (Eigen::Index p = 0; p < particles; ++p) {
+    basis.first[static_cast<std::size_t>(p)] = static_cast<int>(3 * p);
+    basis.vectors.middleCols<3>(3 * p).setIdentity();
+  }
+  return basis;
+}
+
+// The exact Hessian (project = false) of every term at once, normals held fixed, against central
+// differences of the gradient; the projected one is positive semi-definite and equal to it where
+// the energy is convex (every spring stretched, no barrier triangle active).
+TEST(SpringEnergy, HessianMatchesFiniteDifferencesOfTheGradient) {
+  const ParticleGrid grid = test::make_quad_grid(4, 3, 1.0);
+  SpringEnergyOptions options = barrier_test_options(true);
+  options.angular_stiffness = 0.4;
+  options.distortion_stiffness = 0.3;
+  const SpringSystem system(grid, options);
+  const SpringSystem::HessianBasis basis = full_basis(grid.num_particles());
+  int tested = 0;
+  for (unsigned seed = 1; seed <= 8; ++seed) {
+    Eigen::Matrix3Xd x = random_configuration(grid, 0.3, seed);
+    x.row(2).setZero();
+    Eigen::Matrix3Xd normals;
+    lift_off_the_plane(seed, x, normals);
+    const SpringEnergies e = system.evaluate(x, nullptr, &normals);
+    if (!std::isfinite(e.total()) || !(e.barrier > 0.0)) {
+      continue;
+    }
+    ++tested;
+    const Eigen::MatrixXd h = Eigen::MatrixXd(system.hessian(x, &normals, basis, false));
+    Eigen::MatrixXd fd(h.rows(), h.cols());
+    const double step = 1e-6;
+    for (Eigen::Index k = 0; k < h.cols(); ++k) {
+      Eigen::Matrix3Xd plus = x, minus = x, g_plus, g_minus;
+      plus(k % 3, k / 3) += step;
+      minus(k % 3, k / 3) -= step;
+      system.evaluate(plus, &g_plus, &normals);
+      system.evaluate(minus, &g_minus, &normals);
+      fd.col(k) = (g_plus - g_minus).reshaped() / (2.0 * step);
+    }
+    EXPECT_LT((fd - h).norm(), 1e-5 * h.norm()) << "seed " << seed;
+    EXPECT_LT((h - h.transpose()).norm(), 1e-12 * h.norm());
+    const Eigen::MatrixXd projected = Eigen::MatrixXd(system.hessian(x, &normals, basis, true));
+    const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(projected);
+    EXPECT_GT(eigen.eigenvalues().minCoeff(), -1e-10 * eigen.eigenvalues().maxCoeff());
+    EXPECT_LT(Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(h).eigenvalues().minCoeff(), 0.0);
+  }
+  EXPECT_GE(tested, 2);
+
+  // Springs alone, every one stretched (a uniform 1.5x scaling of the rest grid at sigma 1.2):
+  // convex, so projecting changes nothing.
+  const SpringSystem springs(grid, {.stiffness = 1.0, .angular_stiffness = 0.4, .rest_scale = 1.2});
+  const Eigen::Matrix3Xd stretched = 1.5 * test::grid_positions(grid);
+  const Eigen::MatrixXd exact = Eigen::MatrixXd(springs.hessian(stretched, nullptr, basis, false));
+  EXPECT_GT(exact.norm(), 0.0);
+  EXPECT_EQ(exact, Eigen::MatrixXd(springs.hessian(stretched, nullptr, basis, true)));
+}
+
+// A reduced basis gives B^T H B: here two tangent vectors per particle of a plane (B: 3P x 2P) and
+// none for the first particle (held).
+TEST(SpringEnergy, HessianInAReducedBasisIsBTransposeHB) {
+  const ParticleGrid grid = test::make_quad_grid(4, 3, 1.0);
+  const SpringSystem system(grid, {.stiffness = 1.0, .angular_stiffness = 0.25, .rest_scale = 0.9});
+  const Eigen::Matrix3Xd x = random_configuration(grid, 0.2, 3);
+  const Eigen::Index n = grid.num_particles();
+  SpringSystem::HessianBasis reduced;
+  reduced.count.assign(static_cast<std::size_t>(n), 2);
+  reduced.count[0] = 0;
+  reduced.first.assign(static_cast<std::size_t>(n), 0);
+  reduced.vectors.resize(3, 2 * (n - 1));
+  Eigen::MatrixXd b = Eigen::MatrixXd::Zero(3 * n, 2 * (n - 1));
+  const Eigen::Vector3d e1 = Eigen::Vector3d(1.0, 0.2, 0.1).normalized();
+  const Eigen::Vector3d e2 = e1.cross(Eigen::Vector3d(0.0, 0.3, 1.0)).normalized();
+  for (Eigen::Index p = 1; p < n; ++p) {
+    const auto first = static_cast<int>(2 * (p - 1));
+    reduced.first[static_cast<std::size_t>(p)] = first;
+    reduced.vectors.col(first) = e1;
+    reduced.vectors.col(first + 1) = e2;
+    b.block<3, 1>(3 * p, first) = e1;
+    b.block<3, 1>(3 * p, first + 1) = e2;
+  }
+  const Eigen::MatrixXd full = Eigen::MatrixXd(system.hessian(x, nullptr, full_basis(n), true));
+  const Eigen::MatrixXd expected = b.transpose() * full * b;
+  EXPECT_LT((Eigen::MatrixXd(system.hessian(x, nullptr, reduced, true)) - expected).norm(),
+            1e-12 * expected.norm());
 }
 
 // One fold test for the solver and the report (face_folds.h): with corner normals that turn by

@@ -63,6 +63,7 @@
 /// reduction. The result is bit-identical for the same input whatever the number of threads.
 
 #include <Eigen/Core>
+#include <Eigen/SparseCore>
 #include <string_view>
 #include <vector>
 
@@ -163,6 +164,26 @@ class SpringSystem {
                           const Eigen::Matrix3Xd* normals = nullptr,
                           Eigen::Matrix3Xd* normal_gradient = nullptr) const;
 
+  /// The Hessian of evaluate()'s energy at `x` in reduced coordinates: K = B^T H B, B the
+  /// block-diagonal basis of `basis` (particle p's motion is B_p z_p). With `normals` the barrier
+  /// sees each triangle along its corners' normals as in evaluate(), the normals held fixed (their
+  /// turning is left out); without them along the unit normal of the triangle itself. With
+  /// `project`, each term's Hessian has its negative eigenvalues set to zero (projected Newton,
+  /// Teran et al. 2005), so K is positive semi-definite: a spring's part along its
+  /// direction 2C n n^T is kept and the part across it, 2C (1 - sigma k / |d|) (I - n n^T),
+  /// dropped where the spring is compressed; a triangle's 6 x 6 Hessian in its edges is clamped
+  /// in its eigenbasis. Terms with a degenerate spring (|d| = 0), an inactive barrier triangle,
+  /// or one whose energy is infinite at `x` are left out. Returns the lower and upper triangle
+  /// (size basis.size() squared). Same entries for any number of threads.
+  struct HessianBasis {
+    std::vector<int> first;    ///< #P: the first reduced coordinate of particle p
+    std::vector<int> count;    ///< #P: how many (0 to 3); 0 for a particle that does not move
+    Eigen::Matrix3Xd vectors;  ///< 3 x size(): the basis vector of each reduced coordinate
+    Eigen::Index size() const { return vectors.cols(); }
+  };
+  Eigen::SparseMatrix<double> hessian(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd* normals,
+                                      const HessianBasis& basis, bool project = true) const;
+
   /// Number of grid faces with at least one folded corner at positions `x`, given unit surface
   /// normals `normals` (3 x #P) at the particles. A corner (prev, i, next) of a counter-clockwise
   /// face is folded when its triangle is inverted in the sense of face_folds.h:
@@ -199,6 +220,10 @@ class SpringSystem {
                                   bool want_gradient) const;
   void gather_gradient(bool with_barrier, Eigen::Matrix3Xd& gradient) const;
   void gather_normal_gradient(Eigen::Matrix3Xd& normal_gradient) const;
+  // The 9 x 9 Hessian of barrier triangle t's terms in (x_i, x_next, x_prev) (spring_hessian.cpp);
+  // false when it has none (inactive, infinite energy, or every term zero).
+  bool triangle_hessian(std::size_t t, const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd* normals,
+                        bool project, Eigen::Matrix<double, 9, 9>& h) const;
 
   const ParticleGrid* grid_ = nullptr;
   SpringEnergyOptions options_;
