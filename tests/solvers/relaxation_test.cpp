@@ -78,19 +78,26 @@ void expect_boundary_untouched(const ParticleGrid& grid, const RelaxationProblem
 struct Mode {
   SolverKind solver = SolverKind::Fast;
   Preconditioner preconditioner = Preconditioner::Direct;
+  NewtonMode newton = NewtonMode::Off;
   void apply(RelaxationOptions& options) const {
     options.solver = solver;
     options.lbfgs.preconditioner = preconditioner;
+    options.lbfgs.newton.mode = newton;
     // Coarsen down to a few dozen unknowns so that the small test grids get a real hierarchy.
     options.lbfgs.multigrid.coarsest_size = 20;
   }
 };
-const auto kModes = ::testing::Values(Mode{SolverKind::Fast, Preconditioner::Direct},
-                                      Mode{SolverKind::Fast, Preconditioner::Multigrid},
-                                      Mode{SolverKind::Faithful, Preconditioner::Direct});
+const auto kModes =
+    ::testing::Values(Mode{SolverKind::Fast, Preconditioner::Direct},
+                      Mode{SolverKind::Fast, Preconditioner::Multigrid},
+                      Mode{SolverKind::Fast, Preconditioner::Multigrid, NewtonMode::On},
+                      Mode{SolverKind::Faithful, Preconditioner::Direct});
 std::string mode_name(const ::testing::TestParamInfo<Mode>& info) {
-  return info.param.solver == SolverKind::Faithful
-             ? std::string("faithful")
+  if (info.param.solver == SolverKind::Faithful) {
+    return "faithful";
+  }
+  return info.param.newton == NewtonMode::On
+             ? std::string("fast_newton")
              : "fast_" + std::string(to_string(info.param.preconditioner));
 }
 
@@ -227,15 +234,68 @@ TEST_P(Cylinder, IsometricBoundaryGivesNearZeroLengthDistortion) {
 
 INSTANTIATE_TEST_SUITE_P(BothSolvers, Cylinder, kModes, mode_name);
 
+// The Newton H0 (NewtonOptions) on the cylinder: from the first iteration it reaches the same
+// map as the Laplacian H0 in a fraction of the iterations (the Hessian knows the curvature of the
+// springs along the roll, the Laplacian only their rest stiffness), factorising every `refresh`
+// iterations. In NewtonMode::Auto a solve that converges before `after` never uses it: the same
+// bits as NewtonMode::Off.
+TEST(Relaxation, NewtonH0ConvergesInFewerIterations) {
+  static const CylinderProblem cylinder;
+  const ParticleGrid grid = test::make_quad_grid(16, 12, 0.1, {-0.8, -0.6});
+  const RelaxationProblem problem =
+      make_problem(grid, cylinder.target(),
+                   cylinder.roll(perturb_interior(grid, test::grid_positions(grid), 0.03, 9)));
+  RelaxationOptions options;
+  options.relative_gradient_tolerance = 1e-10;
+  options.lbfgs.newton.mode = NewtonMode::Off;
+  const RelaxationResult off = relax(problem, options);
+  options.lbfgs.newton.mode = NewtonMode::On;
+  options.lbfgs.newton.refresh = 1;
+  const RelaxationResult on = relax(problem, options);
+  options.lbfgs.newton.refresh = 3;
+  const RelaxationResult every3 = relax(problem, options);
+  ASSERT_TRUE(off.converged && on.converged && every3.converged);
+  // The perturbed start squeezes some triangles into the barrier's range (E_bar above the
+  // springs' energy): the first iterations keep the Laplacian H0 (NewtonOptions::barrier_share).
+  EXPECT_EQ(off.newton_iterations, 0);
+  EXPECT_GT(on.newton_iterations, on.iterations * 4 / 5);
+  EXPECT_EQ(on.newton_factorisations, on.newton_iterations);
+  EXPECT_LE(every3.newton_factorisations, every3.newton_iterations / 3 + 2);
+  EXPECT_LT(3 * on.iterations, 2 * off.iterations) << on.iterations << " vs " << off.iterations;
+  EXPECT_LT(every3.iterations, off.iterations);
+  EXPECT_LT((on.positions - off.positions).colwise().norm().maxCoeff(), 1e-7);
+  EXPECT_LT((every3.positions - off.positions).colwise().norm().maxCoeff(), 1e-7);
+
+  options.lbfgs.newton.mode = NewtonMode::Auto;
+  options.lbfgs.newton.after = off.iterations + 1;
+  const RelaxationResult late = relax(problem, options);
+  EXPECT_EQ(late.newton_iterations, 0);
+  EXPECT_EQ(late.iterations, off.iterations);
+  EXPECT_TRUE((late.positions.array() == off.positions.array()).all());
+  options.lbfgs.newton.after = 5;
+  const int free = grid.num_particles() - static_cast<int>(grid.boundary_loop.size());
+  options.lbfgs.newton.max_particles = free - 1;  // one too few for this grid
+  EXPECT_EQ(relax(problem, options).newton_iterations, 0);
+  options.lbfgs.newton.max_particles = free;
+  const RelaxationResult early = relax(problem, options);
+  EXPECT_GT(early.newton_iterations, 0);
+  EXPECT_LE(early.newton_iterations, early.iterations - 5);
+  EXPECT_LT(early.iterations, off.iterations);
+}
+
 TEST(Relaxation, SameInputsGiveTheSameBitsForAnyThreadCount) {
   const ParticleGrid grid = test::make_quad_grid(12, 10, 0.1, {-0.6, -0.5});
   const Eigen::Isometry3d motion(Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitX()));
   const Target target(test::make_plane_mesh(4, 1.0, motion));
   const RelaxationProblem problem = make_problem(
       grid, target, motion * perturb_interior(grid, test::grid_positions(grid), 0.03, 3));
-  for (const Preconditioner preconditioner : {Preconditioner::Direct, Preconditioner::Multigrid}) {
+  for (const auto& [preconditioner, newton] :
+       {std::pair{Preconditioner::Direct, NewtonMode::Off},
+        std::pair{Preconditioner::Multigrid, NewtonMode::Off},
+        std::pair{Preconditioner::Multigrid, NewtonMode::On}}) {
     RelaxationOptions options;
     options.lbfgs.preconditioner = preconditioner;
+    options.lbfgs.newton.mode = newton;
     options.lbfgs.multigrid.coarsest_size = 20;
     options.threads = 2;
     const RelaxationResult a = relax(problem, options);

@@ -275,16 +275,16 @@ TEST(SpringEnergy, HessianInAReducedBasisIsBTransposeHB) {
   const Eigen::Matrix3Xd x = random_configuration(grid, 0.2, 3);
   const Eigen::Index n = grid.num_particles();
   SpringSystem::HessianBasis reduced;
-  reduced.count.assign(static_cast<std::size_t>(n), 2);
-  reduced.count[0] = 0;
-  reduced.first.assign(static_cast<std::size_t>(n), 0);
+  for (Eigen::Index p = 0; p < n; ++p) {
+    reduced.count.push_back(p == 0 ? 0 : 2);
+    reduced.first.push_back(p == 0 ? 0 : static_cast<int>(2 * (p - 1)));
+  }
   reduced.vectors.resize(3, 2 * (n - 1));
   Eigen::MatrixXd b = Eigen::MatrixXd::Zero(3 * n, 2 * (n - 1));
   const Eigen::Vector3d e1 = Eigen::Vector3d(1.0, 0.2, 0.1).normalized();
   const Eigen::Vector3d e2 = e1.cross(Eigen::Vector3d(0.0, 0.3, 1.0)).normalized();
   for (Eigen::Index p = 1; p < n; ++p) {
-    const auto first = static_cast<int>(2 * (p - 1));
-    reduced.first[static_cast<std::size_t>(p)] = first;
+    const int first = reduced.first[static_cast<std::size_t>(p)];
     reduced.vectors.col(first) = e1;
     reduced.vectors.col(first + 1) = e2;
     b.block<3, 1>(3 * p, first) = e1;

@@ -27,7 +27,9 @@ namespace {
 
 namespace fs = std::filesystem;
 
-struct RobustnessArgs : BenchCaseArgs {};
+struct RobustnessArgs : BenchCaseArgs {
+  std::string newton = "auto";  ///< --newton: ElasticPaint's only non-default choice allowed
+};
 
 const std::vector<std::string> kBaselines = {"lscm", "arap", "dcm"};
 
@@ -118,6 +120,7 @@ nlohmann::json run_case(const nlohmann::json& c, const RobustnessArgs& args, Sur
   job.target_anchor = c.value("target_anchor", "");
   job.particles = c["particles"].get<long>();
   job.threads = args.threads;
+  job.newton = args.newton;
   job.quiet = true;
   if (const std::string missing = missing_input(job); !missing.empty()) {
     out["error"] = missing + " is not present";
@@ -363,6 +366,10 @@ std::function<int()> add_robustness_subcommand(CLI::App& bench) {
       "robustness",
       "Real meshes and ordinary choices: ElasticPaint (defaults) and the baselines, pass/fail");
   add_bench_case_options(*sub, *a, "robustness_cases.json");
+  sub->add_option("--newton", a->newton,
+                  "ElasticPaint's --newton (default auto, as a user gets it): off compares "
+                  "the Laplacian H0 alone on the same cases")
+      ->check(CLI::IsMember({"auto", "on", "off"}));
   sub->footer(
       "Example:\n  elastic bench robustness --report robustness.json --markdown robustness.md\n"
       "Prints the table on stdout; exits 0 when every case ran (passing or not).");

@@ -155,6 +155,11 @@ void add_map_flags(CLI::App& sub, MapJob& a) {
   sub.add_option("--preconditioner", a.preconditioner,
                  "H0 of lbfgs: multigrid (V-cycle, default) or direct (exact factorisation)")
       ->check(CLI::IsMember({"multigrid", "direct"}));
+  sub.add_option("--newton", a.newton,
+                 "auto (default: H0 of lbfgs becomes the energy's Hessian after 50 iterations "
+                 "without convergence, on grids of up to 10,000 particles), on (from the start, "
+                 "any size) or off (the Laplacian H0 throughout)")
+      ->check(CLI::IsMember({"auto", "on", "off"}));
   sub.add_option("--rest-scale", a.rest_scale,
                  "auto (default: the smaller of boundary and area) | boundary | area | none")
       ->check(CLI::IsMember({"auto", "boundary", "area", "none"}));
@@ -229,6 +234,7 @@ MapOptions make_map_options(const MapJob& job, const ProgressCallback& progress)
                                     : parse_boundary_mode(job.boundary, "--boundary");
   options.relaxation.lbfgs.preconditioner =
       parse_preconditioner(job.preconditioner, "--preconditioner");
+  options.relaxation.lbfgs.newton.mode = parse_newton_mode(job.newton, "--newton");
   options.relaxation.threads = job.threads;
   options.relaxation.max_iterations = job.max_iterations;
   if (job.angular_stiffness != "auto") {
@@ -453,6 +459,10 @@ nlohmann::json map_report(const MapJob& job, const MapSession& session,
       {"solver", job.solver},
       {"preconditioner", x.solver == SolverKind::Fast ? std::string(to_string(x.preconditioner))
                                                       : std::string("none")},
+      {"newton",
+       {{"mode", job.newton},
+        {"iterations", x.newton_iterations},
+        {"factorisations", x.newton_factorisations}}},
       {"iterations", x.iterations},
       {"converged", x.converged},
       {"reason", std::string(to_string(x.reason))},

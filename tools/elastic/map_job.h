@@ -41,6 +41,7 @@ struct MapJob {
   long particles = 1000;                     ///< --particles N
   std::string solver = "lbfgs";              ///< --solver lbfgs|explicit
   std::string preconditioner = "multigrid";  ///< --preconditioner multigrid|direct (lbfgs)
+  std::string newton = "auto";               ///< --newton auto|on|off (lbfgs)
   std::string rest_scale = "auto";           ///< --rest-scale auto|boundary|area|none
   std::string energy = "robust";             ///< --energy robust|paper
   std::string angular_stiffness = "auto";    ///< --angular-stiffness auto|C_a / C

@@ -15,6 +15,7 @@
 
 #include "elastic/core/error.h"
 #include "elastic/core/huge_pages.h"
+#include "elastic/solvers/newton_preconditioner.h"
 #include "elastic/solvers/solver_common.h"
 
 namespace elastic {
@@ -188,6 +189,10 @@ class LbfgsRun {
     laplacian_.emplace(solver_detail::interior_laplacian(setup_, options_),
                        solver_detail::interior_coordinates(setup_), lb_);
     result_.preconditioner = laplacian_->kind();
+    const NewtonOptions& newton = lb_.newton;
+    newton_allowed_ = (newton.mode == NewtonMode::On ||
+                       (newton.mode == NewtonMode::Auto && n_ <= newton.max_particles)) &&
+                      (newton.in_slide || !setup_.slide);
     held_.assign(static_cast<std::size_t>(n_), 0);
     resize_huge(solved_, m_, 1);
     setup_.springs.folded_corners(setup_.positions, setup_.normals, folded_);
@@ -272,6 +277,7 @@ class LbfgsRun {
       if (converged() || !free_gradient_or_release() || out_of_budget()) {
         break;
       }
+      choose_h0();
       choose_direction();
       if (!line_search()) {
         if (!memory_.empty()) {  // retry from the preconditioned gradient before giving up
@@ -346,6 +352,10 @@ class LbfgsRun {
     if (iteration_ >= max_iterations_) {
       return true;
     }
+    if (settled()) {
+      result_.reason = StopReason::Settled;
+      return true;
+    }
     if (!report_progress(options_.progress, {.stage = "relax",
                                              .iteration = iteration_,
                                              .total = max_iterations_,
@@ -355,6 +365,21 @@ class LbfgsRun {
       return true;
     }
     return false;
+  }
+
+  // The slide's settle test (RelaxationOptions::slide_settle_tolerance): the energy of each
+  // iterate is kept for kSettleWindow iterations.
+  bool settled() {
+    if (!(setup_.slide && options_.slide_settle_tolerance > 0.0)) {
+      return false;
+    }
+    const double energy = energies_.total();
+    recent_.push_back(energy);
+    if (static_cast<long>(recent_.size()) <= kSettleWindow) {
+      return false;
+    }
+    recent_.pop_front();
+    return recent_.front() - energy <= options_.slide_settle_tolerance * std::abs(energy);
   }
 
   bool is_held(Eigen::Index i) const { return held_[static_cast<std::size_t>(i % n_)] != 0; }
@@ -380,9 +405,55 @@ class LbfgsRun {
         sum_chunks(m_, [&](Eigen::Index i) { return is_held(i) ? 0.0 : v[i] * v[i]; }));
   }
 
-  // v = masked L^-1 (masked v).
+  // Which H0 this iteration uses (NewtonOptions): the Newton H0 once `after` iterations have
+  // passed (at once for NewtonMode::On) while the barrier's energy is within its share of the
+  // springs', refactorised every `refresh` iterations; else L^-1. A change of H0 clears the
+  // memory: its pairs were taken with the other one.
+  void choose_h0() {
+    if (!newton_allowed_) {
+      return;
+    }
+    const NewtonOptions& newton = lb_.newton;
+    const long after = newton.mode == NewtonMode::On ? 0 : newton.after;
+    bool use = iteration_ >= after &&
+               energies_.barrier <= newton.barrier_share * (energies_.length + energies_.angular);
+    if (use && !newton_) {  // built at its first use: most solves converge before `after`
+      newton_.emplace(setup_, solver_detail::interior_laplacian(setup_, options_));
+    }
+    if (use && (!newton_->ready() || !newton_on_ ||
+                iteration_ - last_factorisation_ >= std::max(newton.refresh, 1))) {
+      use = refactorise();
+    }
+    if (use != newton_on_) {
+      memory_.clear();
+      newton_on_ = use;
+    }
+    result_.newton_iterations += use ? 1 : 0;
+  }
+
+  // Factorises the Newton H0 at the current iterate, without the held particles.
+  bool refactorise() {
+    const bool ok = newton_->refresh(setup_.positions, setup_.normals, setup_.curve_tangent,
+                                     gradient_, frames_, held_);
+    last_factorisation_ = iteration_;
+    newton_held_ = held_count_;
+    ++result_.newton_factorisations;
+    return ok;
+  }
+
+  // v = masked H0 (masked v): L^-1, or the Newton H0 (refactorised when particles were held
+  // since its last factorisation).
   void apply_h0(Eigen::VectorXd& v) {
     mask(v);
+    if (newton_on_ && held_count_ != newton_held_ && !refactorise()) {
+      newton_on_ = false;  // particles were held since: K without them, or L^-1 if that fails
+      memory_.clear();
+    }
+    if (newton_on_) {
+      newton_->apply(v);
+      mask(v);
+      return;
+    }
     laplacian_->solve3(v, solved_);
     v.swap(solved_);
     mask(v);
@@ -687,6 +758,13 @@ class LbfgsRun {
   const Eigen::Index m_ = 3 * n_;
   const InteriorLayout layout_{&setup_, n_};
   std::optional<solver_detail::LaplacianInverse> laplacian_;
+  // The Newton H0 (LbfgsOptions::newton): whether this solve may use it, the operator (built at
+  // its first use), whether it is in use now.
+  bool newton_allowed_ = false;
+  std::optional<solver_detail::NewtonPreconditioner> newton_;
+  bool newton_on_ = false;
+  long last_factorisation_ = 0;   // iteration of the Newton H0's last factorisation
+  Eigen::Index newton_held_ = 0;  // held particles at that factorisation
   bool with_barrier_ = false;
   double noise_factor_ = 0.0;
   double initial_norm_ = 0.0;  // the reference of the relative gradient test
@@ -726,6 +804,7 @@ class LbfgsRun {
   bool trial_q_ready_ = false;  // trial_q_ already holds the trial's tangential gradient
 
   long iteration_ = 0;
+  std::deque<double> recent_;  // energies of the last iterates (settled())
   int stalled_ = 0;  // consecutive steps that changed the energy by less than its round-off
   bool at_round_off_ = false;
 };

@@ -40,10 +40,21 @@
 ///    smaller.
 /// 6. The pair (s, y) is kept when s . y > 1e-12 |s| |y| (curvature condition).
 ///
-/// Stopping: see relaxation.h (tangential gradient only). When particles are held and the
-/// tangential gradient of all the others meets the tolerance, the held ones are released once
-/// (memory cleared); if they are held again and the rest settles again, the energy minimum lies
-/// beyond the no-fold constraint: the solver stops with StopReason::FoldConstrained (not
+/// 7. The Newton H0 (LbfgsOptions::newton, newton_preconditioner.h): in the default
+/// NewtonMode::Auto,
+///    after 50 iterations without convergence on a grid of at most 10,000 free particles (outside
+///    a sliding boundary's slide phase, and while the barrier's energy is at most the springs'),
+///    H0 is the energy's own Hessian in the tangent planes, K^-1, refactorised every 4 iterations,
+///    instead of L^-1 (the memory is cleared when H0 changes). Where the map is far from rest,
+///    compressed, or pressed against the barrier, L is a poor model and the pairs cannot make up
+///    for it; K is the model itself.
+///
+/// Stopping: see relaxation.h (tangential gradient only). The slide phase of a sliding boundary
+/// also stops when 20 iterations lowered its energy by less than
+/// RelaxationOptions::slide_settle_tolerance of it (StopReason::Settled). When particles are held
+/// and the tangential gradient of all the others meets the tolerance, the held ones are released
+/// once (memory cleared); if they are held again and the rest settles again, the energy minimum
+/// lies beyond the no-fold constraint: the solver stops with StopReason::FoldConstrained (not
 /// converged, no folds, RelaxationResult::held_particles lists them). This is the case of a square
 /// source region mapped onto a round target boundary with 2,000 particles: its 90-degree corners
 /// must open to 180 degrees, and the explicit solver run to equilibrium folds faces next to them.

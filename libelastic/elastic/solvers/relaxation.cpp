@@ -48,6 +48,32 @@ Preconditioner parse_preconditioner(std::string_view text, std::string_view inpu
                                                   "' (expected multigrid or direct)");
 }
 
+std::string_view to_string(NewtonMode mode) {
+  switch (mode) {
+    case NewtonMode::Auto:
+      return "auto";
+    case NewtonMode::On:
+      return "on";
+    case NewtonMode::Off:
+      return "off";
+  }
+  return "unknown";
+}
+
+NewtonMode parse_newton_mode(std::string_view text, std::string_view input) {
+  if (text == "auto") {
+    return NewtonMode::Auto;
+  }
+  if (text == "on") {
+    return NewtonMode::On;
+  }
+  if (text == "off") {
+    return NewtonMode::Off;
+  }
+  throw InvalidInputError(std::string(input), "unknown Newton mode '" + std::string(text) +
+                                                  "' (expected auto, on or off)");
+}
+
 std::string_view to_string(StopReason reason) {
   switch (reason) {
     case StopReason::RelativeGradient:
@@ -68,6 +94,8 @@ std::string_view to_string(StopReason reason) {
       return "diverged (non-finite energy or positions)";
     case StopReason::Cancelled:
       return "cancelled";
+    case StopReason::Settled:
+      return "energy settled";
   }
   return "unknown";
 }
@@ -174,6 +202,8 @@ RelaxationResult relax_fast_paper(const RelaxationProblem& problem,
 void add_work(RelaxationResult& to, const RelaxationResult& from) {
   to.iterations += from.iterations;
   to.evaluations += from.evaluations;
+  to.newton_iterations += from.newton_iterations;
+  to.newton_factorisations += from.newton_factorisations;
   to.setup_seconds += from.setup_seconds;
   to.solve_seconds += from.solve_seconds;
 }

@@ -59,8 +59,14 @@ enum class StopReason {
                      ///< back from folding a face (the energy minimum is folded; L-BFGS); they
                      ///< are listed in RelaxationResult::held_particles
   Diverged,          ///< not converged: the energy or a position became non-finite (explicit)
-  Cancelled          ///< not converged: the progress callback asked to stop
+  Cancelled,         ///< not converged: the progress callback asked to stop
+  /// the slide phase of a sliding boundary only (L-BFGS): its energy fell by less than
+  /// RelaxationOptions::slide_settle_tolerance over the last kSettleWindow iterations
+  Settled
 };
+/// Iterations over which RelaxationOptions::slide_settle_tolerance is judged.
+inline constexpr long kSettleWindow = 20;
+
 /// A short lower-case description, e.g. "relative tangential gradient below tolerance".
 std::string_view to_string(StopReason reason);
 /// True for the reasons that mean convergence.
@@ -105,6 +111,49 @@ std::string_view to_string(Preconditioner kind);
 Preconditioner parse_preconditioner(std::string_view text,
                                     std::string_view input = "preconditioner");
 
+/// When the L-BFGS solver's H0 is the energy's own Hessian (newton_preconditioner.h) instead of
+/// the spring Laplacian's inverse.
+enum class NewtonMode {
+  /// After NewtonOptions::after iterations without convergence, on grids of at most
+  /// NewtonOptions::max_particles free particles: a solve that converges quickly never pays for
+  /// a factorisation, and one that does not gets a Hessian that knows where the barrier stiffens
+  /// and which springs are compressed.
+  Auto,
+  On,  ///< from the first iteration, at any size
+  Off  ///< never: H0 is the Laplacian's inverse throughout
+};
+/// "auto", "on", "off".
+std::string_view to_string(NewtonMode mode);
+/// Parses "auto", "on" or "off". \throws InvalidInputError naming `input` otherwise.
+NewtonMode parse_newton_mode(std::string_view text, std::string_view input = "newton");
+
+struct NewtonOptions {
+  NewtonMode mode = NewtonMode::Auto;
+  /// NewtonMode::Auto: iterations of the Laplacian H0 first. 50: the robustness benchmark's
+  /// cases that converge within it keep their results to the bit, and those that took 100 to
+  /// 2,200 iterations take 2 to 5 times fewer (docs/solvers.md).
+  long after = 50;
+  /// NewtonMode::Auto: the largest grid (free particles) that gets the Newton H0. Its sparse
+  /// factorisation costs about as much as 1 L-BFGS iteration at 2,000 particles and 5 at 20,000.
+  int max_particles = 10000;
+  /// Iterations between two factorisations of the Hessian (the L-BFGS pairs correct the H0 of
+  /// the iterations in between), >= 1. 4: on the benchmark's slowest cases as few iterations as
+  /// a factorisation every iteration, in 1.2-2x less time (every 8: an iteration count up to
+  /// 1.8x larger, and a different local minimum on one case; docs/solvers.md).
+  int refresh = 4;
+  /// The Newton H0 is used only while the barrier's energy is at most this times the springs'
+  /// (E_len + E_ang): far from its minimum the barrier (g/g0 - 1)^3 is steep, and a Newton step
+  /// on a power law moves only a fraction of the way to its zero (on the star polygon's start,
+  /// E = 2.7e10, it crept for 60 iterations where the Laplacian H0's longer steps took 12).
+  double barrier_share = 1.0;
+  /// Whether the slide phase of a sliding boundary uses it too. Off: the slide decides where the
+  /// boundary goes, and with the Newton H0 it went elsewhere on the robustness benchmark's knife
+  /// edge, the star polygon onto spot's flank (length energy 5% lower, but sigma_min 0.200
+  /// against the bar's 0.2, where the Laplacian H0's slide ends at 0.208). Held where the slide
+  /// left it, the interior has one minimum, which the Newton H0 reaches in fewer iterations.
+  bool in_slide = false;
+};
+
 /// Options of the L-BFGS solver.
 struct LbfgsOptions {
   int memory = 8;           ///< number of (s, y) pairs kept
@@ -115,6 +164,7 @@ struct LbfgsOptions {
   /// the only one that scales to millions.
   Preconditioner preconditioner = Preconditioner::Multigrid;
   MultigridOptions multigrid;  ///< the V-cycle's parameters (Preconditioner::Multigrid)
+  NewtonOptions newton;        ///< when H0 is the energy's Hessian instead
 };
 
 /// What the boundary particles do during the relaxation.
@@ -201,6 +251,13 @@ struct RelaxationOptions {
   /// only after another 200-450 iterations (a slow escape from a symmetric saddle), 5-20x the
   /// whole solve. Values below `relative_gradient_tolerance` act as it.
   double slide_tolerance = 1e-3;
+  /// Sliding boundary (fast solver): the slide phase also stops (StopReason::Settled) when its
+  /// last kSettleWindow iterations lowered the energy by less than this fraction of it; 0: never.
+  /// At a kink of the piecewise-smooth curve the gradient does not vanish, and the slide crept on
+  /// with line-search steps of 1e-3 to 1e-8 after its energy had settled to six digits, until its
+  /// 500-iteration limit: 280 of the triangle polygon -> spot flank case's slide iterations
+  /// changed its energy by 4e-6 of it (docs/solvers.md).
+  double slide_settle_tolerance = 1e-6;
   /// L-BFGS: when the energy no longer changes beyond its round-off floor, the stop counts as
   /// converged (StopReason::RoundOff) if |P g| <= this * initial |P g|.
   double round_off_gradient_tolerance = 1e-4;
@@ -258,6 +315,10 @@ struct RelaxationResult {
   StopReason reason = StopReason::MaxIterations;
   /// L-BFGS: the H0 used.
   Preconditioner preconditioner = Preconditioner::Multigrid;
+  /// L-BFGS: iterations whose H0 was the energy's Hessian (NewtonOptions), and the Hessian's
+  /// factorisations.
+  long newton_iterations = 0;
+  long newton_factorisations = 0;
   double setup_seconds =
       0.0;  ///< incidence tables, Laplacian and its H0 (multigrid or factor), normals
   double solve_seconds = 0.0;              ///< the iterations

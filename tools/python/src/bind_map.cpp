@@ -44,6 +44,7 @@ struct MapKeywords {
   double curvature_radius = AdaptiveSamplingOptions{}.curvature_radius;
   double distortion_weight = 0.0;
   bool distortion_guard = true;
+  std::string newton = "auto";
 };
 
 // The MapOptions of `elastic map` for the same flags (tools/elastic/map_job.cpp).
@@ -87,6 +88,7 @@ MapOptions map_options(const MapKeywords& k) {
                                                      : parse_boundary_mode(k.boundary, "boundary");
   options.relaxation.lbfgs.preconditioner =
       parse_preconditioner(k.preconditioner, "preconditioner");
+  options.relaxation.lbfgs.newton.mode = parse_newton_mode(k.newton, "newton");
   options.relaxation.threads = k.threads;
   options.relaxation.max_iterations = k.max_iterations;
   if (!k.angular_stiffness.is_none()) {
@@ -487,7 +489,8 @@ void bind_map(py::module_& m) {
          const std::string& preconditioner, const py::object& angular_stiffness, int subdivide,
          int threads, double jitter, unsigned long seed, long max_iterations,
          double curvature_radius, double distortion_weight, bool distortion_guard,
-         const py::object& progress, const std::shared_ptr<MapState>& previous) {
+         const std::string& newton, const py::object& progress,
+         const std::shared_ptr<MapState>& previous) {
         const MapKeywords k{particles,
                             solver,
                             energy,
@@ -503,7 +506,8 @@ void bind_map(py::module_& m) {
                             max_iterations,
                             curvature_radius,
                             distortion_weight,
-                            distortion_guard};
+                            distortion_guard,
+                            newton};
         return run_map(source_region, target_region, k, progress, previous);
       },
       py::arg("source_region"), py::arg("target_region"), py::kw_only(),
@@ -514,7 +518,7 @@ void bind_map(py::module_& m) {
       py::arg("jitter") = 0.0, py::arg("seed") = 0, py::arg("max_iterations") = 0,
       py::arg("curvature_radius") = AdaptiveSamplingOptions{}.curvature_radius,
       py::arg("distortion_weight") = 0.0, py::arg("distortion_guard") = true,
-      py::arg("progress") = py::none(), py::arg("previous") = nullptr,
+      py::arg("newton") = "auto", py::arg("progress") = py::none(), py::arg("previous") = nullptr,
       "Maps source_region onto target_region (each a Region of its Surface) with the particle "
       "system: the keywords are the flags of `elastic map` (docs/cli.md) with underscores. "
       "progress: called as progress(stage, iteration, total, energy, gradient); return False to "

@@ -245,6 +245,20 @@ def test_distortion_weight_matches_the_tools_flag(plane, cap, plane_cap, tmp_pat
     assert m.energy["length"] == pytest.approx(report["energy"]["length"], rel=1e-12)
 
 
+def test_newton_matches_the_tools_flag(plane, cap, plane_cap, tmp_path):
+    # Newton's H0 from the first iteration (docs/solvers.md): another path to the same minimum.
+    report = tool_report("map", dict(PLANE_CAP, newton="on"), tmp_path)
+    assert report["newton"]["mode"] == "on" and report["newton"]["iterations"] > 0
+    m = elastic.map_regions(plane.region(PLANE_CAP["source-region"]),
+                            cap.region(PLANE_CAP["target-region"]),
+                            particles=PLANE_CAP["particles"], newton="on", threads=2)
+    assert m.ok and m.iterations == report["iterations"] != plane_cap.iterations
+    assert m.energy["length"] == pytest.approx(report["energy"]["length"], rel=1e-12)
+    assert m.energy["length"] == pytest.approx(plane_cap.energy["length"], rel=1e-3)
+    with pytest.raises(elastic.InvalidInputError, match="newton"):
+        elastic.map_regions(plane.region("boundary"), cap.region("boundary"), newton="always")
+
+
 def test_distortion_guard_matches_the_tools_flag(plane, tmp_path):
     # A flat disk onto the top of spot's back: the guard acts (docs/solvers.md); off, it does not.
     job = {"source": str(MESHES / "grid.off"), "source-region": "disk:0.5,0.5,0,0.45",
