@@ -129,17 +129,18 @@ NewtonMode parse_newton_mode(std::string_view text, std::string_view input = "ne
 
 struct NewtonOptions {
   NewtonMode mode = NewtonMode::Auto;
-  /// NewtonMode::Auto: iterations of the Laplacian H0 first. 50: the robustness benchmark's
-  /// cases that converge within it keep their results to the bit, and those that took 100 to
-  /// 2,200 iterations take 2 to 5 times fewer (docs/solvers.md).
+  /// NewtonMode::Auto: iterations of the Laplacian H0 first (per phase of the solve). 50: of the
+  /// robustness benchmark's 56 cases 34 keep their results to the bit, and all take 13,447
+  /// iterations instead of 22,383; its slowest cases 2.4 to 3.7 times fewer (docs/solvers.md).
   long after = 50;
   /// NewtonMode::Auto: the largest grid (free particles) that gets the Newton H0. Its sparse
   /// factorisation costs about as much as 1 L-BFGS iteration at 2,000 particles and 5 at 20,000.
   int max_particles = 10000;
   /// Iterations between two factorisations of the Hessian (the L-BFGS pairs correct the H0 of
-  /// the iterations in between), >= 1. 4: on the benchmark's slowest cases as few iterations as
-  /// a factorisation every iteration, in 1.2-2x less time (every 8: an iteration count up to
-  /// 1.8x larger, and a different local minimum on one case; docs/solvers.md).
+  /// the iterations in between), >= 1. 4: on four of the benchmark's slowest cases about as few
+  /// iterations as a factorisation every iteration, in 1.5-1.9x less time (every 8: up to 1.8x
+  /// more iterations, and a different local minimum on one case); measured with the Newton H0
+  /// in the slide too (in_slide).
   int refresh = 4;
   /// The Newton H0 is used only while the barrier's energy is at most this times the springs'
   /// (E_len + E_ang): far from its minimum the barrier (g/g0 - 1)^3 is steep, and a Newton step
