@@ -157,8 +157,9 @@ void add_map_flags(CLI::App& sub, MapJob& a) {
       ->check(CLI::IsMember({"multigrid", "direct"}));
   sub.add_option("--newton", a.newton,
                  "auto (default: H0 of lbfgs becomes the energy's Hessian after 50 iterations "
-                 "without convergence, on grids of up to 10,000 particles), on (from the start, "
-                 "any size) or off (the Laplacian H0 throughout)")
+                 "without convergence, on grids of up to 10,000 particles), on (from the first "
+                 "iteration, any size) or off (the Laplacian H0 throughout); with a sliding "
+                 "boundary, in its held phase only")
       ->check(CLI::IsMember({"auto", "on", "off"}));
   sub.add_option("--rest-scale", a.rest_scale,
                  "auto (default: the smaller of boundary and area) | boundary | area | none")
