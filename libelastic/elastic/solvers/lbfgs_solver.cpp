@@ -186,13 +186,16 @@ class LbfgsRun {
   void prepare() {
     // H0 = L^-1, L the interior spring Laplacian: factorised once in nested-dissection order, or
     // approximated by a multigrid V-cycle on large grids (LbfgsOptions::preconditioner).
-    laplacian_.emplace(solver_detail::interior_laplacian(setup_, options_),
-                       solver_detail::interior_coordinates(setup_), lb_);
+    Eigen::SparseMatrix<double> laplacian = solver_detail::interior_laplacian(setup_, options_);
+    laplacian_.emplace(laplacian, solver_detail::interior_coordinates(setup_), lb_);
     result_.preconditioner = laplacian_->kind();
     const NewtonOptions& newton = lb_.newton;
     newton_allowed_ = (newton.mode == NewtonMode::On ||
                        (newton.mode == NewtonMode::Auto && n_ <= newton.max_particles)) &&
                       (newton.in_slide || !setup_.slide);
+    if (newton_allowed_) {
+      newton_laplacian_.swap(laplacian);  // kept for the Newton H0's regularisation
+    }
     held_.assign(static_cast<std::size_t>(n_), 0);
     resize_huge(solved_, m_, 1);
     setup_.springs.folded_corners(setup_.positions, setup_.normals, folded_);
@@ -418,7 +421,8 @@ class LbfgsRun {
     bool use = iteration_ >= after &&
                energies_.barrier <= newton.barrier_share * (energies_.length + energies_.angular);
     if (use && !newton_) {  // built at its first use: most solves converge before `after`
-      newton_.emplace(setup_, solver_detail::interior_laplacian(setup_, options_));
+      newton_.emplace(setup_, newton_laplacian_);
+      newton_laplacian_ = Eigen::SparseMatrix<double>();  // the operator holds its copy
     }
     if (use && (!newton_->ready() || !newton_on_ ||
                 iteration_ - last_factorisation_ >= std::max(newton.refresh, 1))) {
@@ -761,6 +765,7 @@ class LbfgsRun {
   // The Newton H0 (LbfgsOptions::newton): whether this solve may use it, the operator (built at
   // its first use), whether it is in use now.
   bool newton_allowed_ = false;
+  Eigen::SparseMatrix<double> newton_laplacian_;  // L, until the Newton H0 is built from it
   std::optional<solver_detail::NewtonPreconditioner> newton_;
   bool newton_on_ = false;
   long last_factorisation_ = 0;   // iteration of the Newton H0's last factorisation
