@@ -30,23 +30,6 @@ constexpr double kRoundOff = 1e-10;
 // folded in 3D or in disk coordinates).
 constexpr int kMaxWalkSteps = 64;
 
-// Splits every grid face into a fan of triangles from its first corner (faces are convex in the
-// grid's layout: quads of the regular grid and triangles of the boundary band).
-std::vector<Eigen::Vector3i> grid_triangles(const GridMesh& mesh) {
-  std::vector<Eigen::Vector3i> triangles;
-  triangles.reserve(mesh.n_faces() * 2);
-  for (const auto fh : mesh.faces()) {
-    std::vector<int> corners;
-    for (const auto vh : mesh.fv_range(fh)) {
-      corners.push_back(vh.idx());
-    }
-    for (size_t k = 1; k + 1 < corners.size(); ++k) {
-      triangles.emplace_back(corners[0], corners[k], corners[k + 1]);
-    }
-  }
-  return triangles;
-}
-
 // neighbours[t][k]: the triangle across the edge of t opposite its corner k (the edge
 // tri[k+1] -> tri[k+2]), or -1 on the grid's boundary. Triangles are consistently oriented, so the
 // neighbour holds the same edge reversed.
@@ -271,7 +254,7 @@ Mapping::Mapping(const ParticleGrid& grid, const SurfaceProjector& source,
   impl->target = &target;
   impl->source_disk = &source_disk;
   impl->target_disk = &target_disk;
-  impl->triangles = grid_triangles(grid.mesh);
+  impl->triangles = grid_triangles(grid);
   impl->neighbours = triangle_neighbours(impl->triangles, n);
   impl->source_points = grid.source_points;
   impl->target_points = target_points;

@@ -124,6 +124,7 @@ double perfect_value(TriangleMetric metric) {
 const std::vector<TriangleMetric>& all_triangle_metrics() {
   static const std::vector<TriangleMetric> all = [] {
     std::vector<TriangleMetric> out;
+    out.reserve(std::size(kMetricNames));
     for (const auto& entry : kMetricNames) {
       out.push_back(entry.metric);
     }
@@ -150,31 +151,6 @@ const std::vector<double>& TriangleValues::values(TriangleMetric metric) const {
       return symmetric_dirichlet;
   }
   return s1;
-}
-
-std::vector<Eigen::Vector3i> grid_triangles(const ParticleGrid& grid, std::vector<int>* faces) {
-  // The same fan as Mapping::triangles(): grid faces are convex in the grid layout (quads of the
-  // regular grid, triangles of the boundary band), so any fan is valid; the first corner's is the
-  // one the mapping queries use, and using it here makes the heatmap show the mapping's triangles.
-  std::vector<Eigen::Vector3i> triangles;
-  triangles.reserve(grid.mesh.n_faces() * 2);
-  if (faces != nullptr) {
-    faces->clear();
-  }
-  std::vector<int> corners;
-  for (const auto fh : grid.mesh.faces()) {
-    corners.clear();
-    for (const auto vh : grid.mesh.fv_range(fh)) {
-      corners.push_back(vh.idx());
-    }
-    for (size_t k = 1; k + 1 < corners.size(); ++k) {
-      triangles.emplace_back(corners[0], corners[k], corners[k + 1]);
-      if (faces != nullptr) {
-        faces->push_back(fh.idx());
-      }
-    }
-  }
-  return triangles;
 }
 
 namespace {

@@ -153,11 +153,6 @@ struct MapMetrics {
   FaceValues per_face;
 };
 
-/// The grid's faces split into triangles, fanned from each face's first corner (the split of
-/// `Mapping::triangles()`). `faces`, when given, receives each triangle's face index.
-std::vector<Eigen::Vector3i> grid_triangles(const ParticleGrid& grid,
-                                            std::vector<int>* faces = nullptr);
-
 /// Measures the map grid source positions -> `target_positions` (3 x #P).
 /// \throws InvalidInputError when sizes disagree (naming them), the grid has no faces or no built
 ///         springs, rest_scale is not finite and positive, or a position is not finite.

@@ -47,6 +47,28 @@ void ParticleGrid::build_springs() {
   }
 }
 
+std::vector<Eigen::Vector3i> grid_triangles(const ParticleGrid& grid, std::vector<int>* faces) {
+  std::vector<Eigen::Vector3i> triangles;
+  triangles.reserve(grid.mesh.n_faces() * 2);
+  if (faces != nullptr) {
+    faces->clear();
+  }
+  std::vector<int> corners;
+  for (const auto fh : grid.mesh.faces()) {
+    corners.clear();
+    for (const auto vh : grid.mesh.fv_range(fh)) {
+      corners.push_back(vh.idx());
+    }
+    for (size_t k = 1; k + 1 < corners.size(); ++k) {
+      triangles.emplace_back(corners[0], corners[k], corners[k + 1]);
+      if (faces != nullptr) {
+        faces->push_back(fh.idx());
+      }
+    }
+  }
+  return triangles;
+}
+
 PolygonMesh to_polygon_mesh(const ParticleGrid& grid, const Eigen::Matrix3Xd& positions) {
   PolygonMesh mesh;
   mesh.positions.reserve(static_cast<size_t>(positions.cols()));

@@ -73,6 +73,13 @@ struct ParticleGrid {
   void build_springs();
 };
 
+/// The grid's faces split into triangles, fanned from each face's first corner (faces are convex in
+/// the grid's layout: quads of the regular grid and triangles of the boundary band, so any fan is
+/// valid). The one split every user of grid triangles shares: Mapping's queries, the metrics and
+/// heatmaps, the multilevel start. `faces`, when given, receives each triangle's face index.
+std::vector<Eigen::Vector3i> grid_triangles(const ParticleGrid& grid,
+                                            std::vector<int>* faces = nullptr);
+
 /// The grid's faces with the given 3 x #P particle positions (e.g. source, naive or relaxed target
 /// positions) as a PolygonMesh for writing; per-vertex texture coordinates are the particles'
 /// source UVs when they carry them, so a written grid shows where every particle came from in the
