@@ -161,6 +161,12 @@ void add_map_flags(CLI::App& sub, MapJob& a) {
                  "iteration, any size) or off (the Laplacian H0 throughout); with a sliding "
                  "boundary, in its held phase only")
       ->check(CLI::IsMember({"auto", "on", "off"}));
+  sub.add_option("--coarse-start", a.coarse_start,
+                 "N: a grid of more than N particles (default 50000) relaxes from the relaxed "
+                 "map of a grid of 1/8 as many, carried onto it, instead of from the naive map "
+                 "(the coarse map chooses the boundary offset and where a sliding boundary goes); "
+                 "0: never")
+      ->check(CLI::Range(0L, static_cast<long>(kMaxParticles)));
   sub.add_option("--rest-scale", a.rest_scale,
                  "auto (default: the smaller of boundary and area) | boundary | area | none")
       ->check(CLI::IsMember({"auto", "boundary", "area", "none"}));
@@ -244,6 +250,7 @@ MapOptions make_map_options(const MapJob& job, const ProgressCallback& progress)
   options.relaxation.distortion_stiffness = job.distortion_weight;
   options.distortion_guard = job.distortion_guard == "on";
   options.subdivisions = job.subdivide;
+  options.coarse_start_above = static_cast<int>(job.coarse_start);
   options.progress = progress;
   options.relaxation.progress = progress;
   return options;
@@ -470,11 +477,12 @@ nlohmann::json map_report(const MapJob& job, const MapSession& session,
       {"seconds",
        {{"total", session.seconds_total},
         {"loading", session.seconds_loading},
-        {"setup", r.seconds_sampling + r.seconds_naive + x.setup_seconds},
+        {"setup", r.seconds_sampling + r.seconds_coarse + r.seconds_naive + x.setup_seconds},
         {"solve", x.solve_seconds},
         {"sampling", r.seconds_sampling},
         {"naive_map", r.seconds_naive},
         {"solver_setup", x.setup_seconds},
+        {"coarse_start", r.seconds_coarse},
         {"mapping", r.seconds_mapping}}},
       {"energy_kind", std::string(to_string(x.energy))},
       {"angular_stiffness", x.angular_stiffness},
@@ -500,6 +508,10 @@ nlohmann::json map_report(const MapJob& job, const MapSession& session,
         {"relaxed", r.guard.relaxed},
         {"guarded", r.guard.guarded},
         {"iterations", r.guard.iterations}}},
+      {"coarse_start",
+       {{"above", job.coarse_start},
+        {"particles", r.coarse_particles},
+        {"iterations", r.coarse_iterations}}},
       {"boundary_residual", x.boundary_residual},
       {"rest_scale", {{"mode", job.rest_scale}, {"factor", r.rest_scale}}},
       {"boundary",

@@ -51,8 +51,10 @@ struct MapJob {
   std::string boundary = "auto";             ///< --boundary auto|fixed|slide
   std::string scheme = "auto";               ///< --scheme auto|loop|catmull-clark
   int subdivide = 0;                         ///< --subdivide K: refinement levels after the map
-  int threads = 0;                           ///< --threads N (0: all)
-  double jitter = 0.0;                       ///< --jitter F: random start of the sampling
+  /// --coarse-start N: grids of more than N particles start from a coarser grid's map (0: never)
+  long coarse_start = MapOptions{}.coarse_start_above;
+  int threads = 0;      ///< --threads N (0: all)
+  double jitter = 0.0;  ///< --jitter F: random start of the sampling
   /// --curvature-radius S: the sampling's curvature averaged over S grid spacings (0: pointwise)
   double curvature_radius = AdaptiveSamplingOptions{}.curvature_radius;
   unsigned long seed = 0;   ///< --seed S: seed of the --jitter

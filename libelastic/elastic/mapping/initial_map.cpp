@@ -322,6 +322,112 @@ InitialMap transported_map(const ParticleGrid& grid, const std::vector<SurfacePo
 
 namespace {
 
+// s(t) of the coarse boundary: the pairs (t_k, s_k) in loop order, t unwrapped to increase once
+// around the loop from t_0 and s likewise (the slide keeps the order); linear in between and
+// across the seam (t_last -> t_0 + 1, s_last -> s_0 + 1).
+class BoundaryCorrespondence {
+ public:
+  BoundaryCorrespondence(const std::vector<double>& t, const std::vector<double>& s)
+      : t_(t), s_(s) {
+    for (std::size_t k = 1; k < t_.size(); ++k) {
+      t_[k] += std::ceil(t_[k - 1] - t_[k]);  // the smallest t_k + n at or above t_{k-1}
+      s_[k] += std::ceil(s_[k - 1] - s_[k]);
+    }
+  }
+
+  double operator()(double t) const {
+    const std::size_t m = t_.size();
+    const double q = t - std::floor(t - t_[0]);  // in [t_0, t_0 + 1)
+    const auto k =
+        static_cast<std::size_t>(std::upper_bound(t_.begin(), t_.end(), q) - t_.begin()) - 1;
+    const double t1 = k + 1 < m ? t_[k + 1] : t_[0] + 1.0;
+    const double s1 = k + 1 < m ? s_[k + 1] : s_[0] + 1.0;
+    const double w = t1 > t_[k] ? std::clamp((q - t_[k]) / (t1 - t_[k]), 0.0, 1.0) : 0.0;
+    return s_[k] + w * (s1 - s_[k]);
+  }
+
+ private:
+  std::vector<double> t_, s_;
+};
+
+}  // namespace
+
+InitialMap prolonged_map(const ParticleGrid& grid, const ParticleGrid& coarse,
+                         const std::vector<SurfacePoint>& coarse_points,
+                         const std::vector<double>& coarse_parameters, const RegionDiskMap& source,
+                         const RegionDiskMap& target, std::vector<double>& boundary_parameters) {
+  const int nc = coarse.num_particles();
+  if (coarse_points.size() != static_cast<std::size_t>(nc) ||
+      coarse_parameters.size() != coarse.boundary_loop.size() || coarse.boundary_loop.size() < 3) {
+    throw InvalidInputError("coarse start",
+                            "the coarse map's points or boundary parameters do "
+                            "not match its grid (" +
+                                std::to_string(nc) + " particles)");
+  }
+  // Each coarse particle on both disks: from the source grid's points, and where it was relaxed.
+  const SourceDiskPoints from = source_disk_points(coarse, source);
+  const SourceDiskPoints to = disk_points(coarse, coarse_points, coarse_parameters, target);
+  std::vector<Eigen::Vector2d> from_disk = from.disk, to_disk = to.disk;
+  int outside = 0;
+  for (int i = 0; i < nc; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    outside += from.outside[k] + to.outside[k];
+    for (const auto* side : {&from, &to}) {
+      if (side->parameter[k] >= 0.0) {
+        const double angle = 2.0 * std::numbers::pi * side->parameter[k];
+        (side == &from ? from_disk : to_disk)[k] = {std::cos(angle), std::sin(angle)};
+      }
+    }
+  }
+  const std::vector<Eigen::Vector3i> triangles = grid_triangles(coarse);
+  const TriangleLocator2D locator(from_disk, triangles);
+
+  const BoundaryCorrespondence s_of_t(coarse.boundary_parameter, coarse_parameters);
+  boundary_parameters.clear();
+  for (const double t : grid.boundary_parameter) {
+    boundary_parameters.push_back(s_of_t(t));
+  }
+
+  // The grid's particles on the source disk, through the coarse map to the target disk.
+  // (Boundary particles keep their parameter s(t): place_on_target puts them on the curve.)
+  SourceDiskPoints fine = disk_points(grid, grid.source_points, boundary_parameters, source);
+  const int n = grid.num_particles();
+  tbb::parallel_for(tbb::blocked_range<int>(0, n, 512), [&](const tbb::blocked_range<int>& r) {
+    for (int i = r.begin(); i != r.end(); ++i) {
+      const auto k = static_cast<std::size_t>(i);
+      if (fine.parameter[k] >= 0.0 || fine.outside[k] != 0) {
+        continue;
+      }
+      const Eigen::Vector2d& p = fine.disk[k];
+      TriangleLocator2D::Hit hit = locator.locate(p, 1e-12);
+      if (!hit.found()) {
+        hit = locator.nearest(p);  // the sliver along the boundary: extrapolate that triangle's map
+        const Eigen::Vector3i& c = triangles[static_cast<std::size_t>(hit.triangle)];
+        const Eigen::Vector3d w = barycentric(from_disk[static_cast<std::size_t>(c[0])],
+                                              from_disk[static_cast<std::size_t>(c[1])],
+                                              from_disk[static_cast<std::size_t>(c[2])], p);
+        if (w.allFinite()) {
+          hit.barycentric = w;
+        }
+      }
+      const Eigen::Vector3i& c = triangles[static_cast<std::size_t>(hit.triangle)];
+      Eigen::Vector2d q = Eigen::Vector2d::Zero();
+      for (int j = 0; j < 3; ++j) {
+        q += hit.barycentric[j] * to_disk[static_cast<std::size_t>(c[j])];
+      }
+      // Extrapolation may leave the disk by round-off of the chord: back onto its inside.
+      const double r2 = q.squaredNorm();
+      constexpr double kInside = 1.0 - 1e-9;
+      fine.disk[k] = r2 > kInside * kInside ? Eigen::Vector2d(q * (kInside / std::sqrt(r2))) : q;
+    }
+  });
+  InitialMap result = place_on_target(fine, target);
+  result.outside += outside;
+  return result;
+}
+
+namespace {
+
 // Faces of the naive map that fold against the target surface: the one fold definition
 // (particles/face_folds.h), with the unit normals at the particles.
 int naive_folds(const ParticleGrid& grid, const InitialMap& naive, const LimitSurface& surface) {

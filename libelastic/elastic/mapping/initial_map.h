@@ -81,6 +81,23 @@ InitialMap transported_map(const ParticleGrid& grid, const std::vector<SurfacePo
                            const std::vector<double>& boundary_parameters,
                            const RegionDiskMap& from, const RegionDiskMap& to);
 
+/// The multilevel start (MapOptions::coarse_start): a relaxed map of a coarser grid of the same
+/// source region carried onto `grid`. The coarse map is read as a map of the unit disk onto itself:
+/// each coarse particle goes from its point on `source`'s disk to its relaxed point on `target`'s
+/// (`coarse_points`; boundary particle k at angle 2 pi coarse_parameters[k], where it slid), and
+/// between the particles it is affine on each coarse grid triangle of the source disk. Each
+/// interior particle of `grid` goes through that map and back from `target`'s disk; one in the
+/// sliver between the coarse boundary polygon and the circle takes the nearest coarse triangle's
+/// affine map, extrapolated. Boundary particle k of `grid`, at source parameter t, lands at
+/// parameter s(t), the coarse (t, s) pairs interpolated linearly around the loop, returned in
+/// `boundary_parameters` (the relaxation's start on the curve). `target` must carry the turn the
+/// coarse map was made with. Particles the disk maps cannot place are counted in `outside`.
+/// 	hrows InvalidInputError when the coarse points or parameters do not match `coarse`.
+InitialMap prolonged_map(const ParticleGrid& grid, const ParticleGrid& coarse,
+                         const std::vector<SurfacePoint>& coarse_points,
+                         const std::vector<double>& coarse_parameters, const RegionDiskMap& source,
+                         const RegionDiskMap& target, std::vector<double>& boundary_parameters);
+
 struct BoundaryOffsetOptions {
   /// Offsets tried: k / candidates of the boundary, k = 0 .. candidates - 1.
   int candidates = 24;

@@ -54,8 +54,20 @@ struct MapOptions {
   /// against.
   bool distortion_guard = true;
   double distortion_guard_ratio = 1.0;
+  /// The multilevel start (fast solver, no subdivision): a grid of more than `coarse_start_above`
+  /// particles relaxes from the relaxed map of a grid of 1/`coarse_start_ratio` as many particles
+  /// of the same source region (mapped by these options, so a million particles go through 125,000
+  /// and 15,625), carried onto it by prolonged_map (mapping/initial_map.h), instead of from the
+  /// naive map. The coarse map decides the boundary offset and, with a sliding boundary, where the
+  /// boundary goes; the fine grid only adds its detail. On the Plane -> Cap benchmark at 1,001,732
+  /// particles the naive start's slide crept for 222 iterations at 0.7 s each, its first ring
+  /// crowded against the hemisphere's rim (docs/results.md, Speed). 0: never.
+  int coarse_start_above = 50000;
+  /// Particles of the fine grid per particle of the coarse one (at least 2).
+  int coarse_start_ratio = 8;
   /// Called between stages ("sample", "naive map", "relax", "subdivide", "relax refined",
-  /// "mapping"); return false to cancel.
+  /// "mapping"; a multilevel start's coarse map reports its own as "coarse sample", ...); return
+  /// false to cancel.
   ProgressCallback progress;
 };
 
@@ -100,6 +112,12 @@ struct MapResult {
   double seconds_sampling = 0.0;  ///< source sampling (layout + adaptive sampling + springs)
   double seconds_naive = 0.0;     ///< disk maps of both regions + naive placement
   double seconds_mapping = 0.0;   ///< building the queryable mapping
+  /// The multilevel start (MapOptions::coarse_start_above), when it ran: the coarse grid's
+  /// particles, its L-BFGS iterations (the levels below it included) and its whole map's seconds
+  /// (0 otherwise). `naive` is still the naive map of the grid (the distortion guard's yardstick).
+  int coarse_particles = 0;
+  long coarse_iterations = 0;
+  double seconds_coarse = 0.0;
   // Subdivision (MapOptions::subdivisions > 0; otherwise these stay empty / equal the sampled
   // grid).
   int sampled_particles = 0;  ///< particles of the sampled grid, before subdivision

@@ -45,6 +45,7 @@ struct MapKeywords {
   double distortion_weight = 0.0;
   bool distortion_guard = true;
   std::string newton = "auto";
+  long coarse_start = MapOptions{}.coarse_start_above;
 };
 
 // The MapOptions of `elastic map` for the same flags (tools/elastic/map_job.cpp).
@@ -60,6 +61,11 @@ MapOptions map_options(const MapKeywords& k) {
   if (k.boundary_offset != "auto" && k.boundary_offset != "anchor") {
     throw py::value_error("boundary_offset: expected 'auto' or 'anchor', got '" +
                           k.boundary_offset + "'");
+  }
+  if (k.coarse_start < 0 || k.coarse_start > kMaxParticles) {
+    throw py::value_error("coarse_start: expected a particle count in [0, " +
+                          std::to_string(kMaxParticles) + "], got " +
+                          std::to_string(k.coarse_start));
   }
   if (k.subdivide < 0 || k.subdivide > 4 || k.threads < 0 || k.max_iterations < 0) {
     throw py::value_error("subdivide (0..4), threads and max_iterations (>= 0) out of range");
@@ -89,6 +95,7 @@ MapOptions map_options(const MapKeywords& k) {
   options.relaxation.lbfgs.preconditioner =
       parse_preconditioner(k.preconditioner, "preconditioner");
   options.relaxation.lbfgs.newton.mode = parse_newton_mode(k.newton, "newton");
+  options.coarse_start_above = static_cast<int>(k.coarse_start);
   options.relaxation.threads = k.threads;
   options.relaxation.max_iterations = k.max_iterations;
   if (!k.angular_stiffness.is_none()) {
@@ -489,7 +496,7 @@ void bind_map(py::module_& m) {
          const std::string& preconditioner, const py::object& angular_stiffness, int subdivide,
          int threads, double jitter, unsigned long seed, long max_iterations,
          double curvature_radius, double distortion_weight, bool distortion_guard,
-         const std::string& newton, const py::object& progress,
+         const std::string& newton, long coarse_start, const py::object& progress,
          const std::shared_ptr<MapState>& previous) {
         const MapKeywords k{particles,
                             solver,
@@ -507,7 +514,8 @@ void bind_map(py::module_& m) {
                             curvature_radius,
                             distortion_weight,
                             distortion_guard,
-                            newton};
+                            newton,
+                            coarse_start};
         return run_map(source_region, target_region, k, progress, previous);
       },
       py::arg("source_region"), py::arg("target_region"), py::kw_only(),
@@ -518,7 +526,8 @@ void bind_map(py::module_& m) {
       py::arg("jitter") = 0.0, py::arg("seed") = 0, py::arg("max_iterations") = 0,
       py::arg("curvature_radius") = AdaptiveSamplingOptions{}.curvature_radius,
       py::arg("distortion_weight") = 0.0, py::arg("distortion_guard") = true,
-      py::arg("newton") = "auto", py::arg("progress") = py::none(), py::arg("previous") = nullptr,
+      py::arg("newton") = "auto", py::arg("coarse_start") = MapOptions{}.coarse_start_above,
+      py::arg("progress") = py::none(), py::arg("previous") = nullptr,
       "Maps source_region onto target_region (each a Region of its Surface) with the particle "
       "system: the keywords are the flags of `elastic map` (docs/cli.md) with underscores. "
       "progress: called as progress(stage, iteration, total, energy, gradient); return False to "
@@ -581,6 +590,7 @@ void bind_map(py::module_& m) {
             py::dict d;
             d["sampling"] = r.seconds_sampling;
             d["naive_map"] = r.seconds_naive;
+            d["coarse_start"] = r.seconds_coarse;
             d["solver_setup"] = r.relaxation.setup_seconds;
             d["solve"] = r.relaxation.solve_seconds;
             d["mapping"] = r.seconds_mapping;
