@@ -317,12 +317,18 @@ TEST(Cli, BenchScaleTimesWholeProcessesBesideLscm) {
   EXPECT_GT(t["total"].get<double>(), 0.0);
   EXPECT_GE(t["process"].get<double>(), t["total"].get<double>());
   EXPECT_GE(t["total"].get<double>(), t["loading"].get<double>() + t["solve"].get<double>());
+  for (const char* stage : {"sampling", "coarse_start", "naive_map", "solver_setup", "mapping"}) {
+    EXPECT_GE(t[stage].get<double>(), 0.0) << stage;
+  }
+  EXPECT_EQ(t["coarse_start"].get<double>(), 0.0);  // 300 particles: no multilevel start
   EXPECT_GT(t["lscm"].get<double>(), 0.0);
   EXPECT_DOUBLE_EQ(size["ratio"].get<double>(),
                    t["process"].get<double>() / t["lscm"].get<double>());
   EXPECT_NE(report["machine"]["allocator"].get<std::string>(), "");
-  // The map process's peak: more than the tool's own code and libraries (about 20 MiB), far less
-  // than a gigabyte at 300 particles.
+  // The map process's own peak (its report's peak_mib, VmHWM): more than the tool's own code and
+  // libraries (about 20 MiB), far less than a gigabyte at 300 particles, and less than this
+  // process's (which ran the map too, and CGAL): ru_maxrss of a spawned child reported its
+  // parent's.
   EXPECT_GT(size["peak_mib"].get<double>(), 10.0);
   EXPECT_LT(size["peak_mib"].get<double>(), 1024.0);
   expect_error(

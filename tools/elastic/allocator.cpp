@@ -87,4 +87,15 @@ std::string allocator_description() {
 #endif
 }
 
+double peak_resident_mib() {
+  std::ifstream status("/proc/self/status");
+  std::string line;
+  while (std::getline(status, line)) {
+    if (line.rfind("VmHWM:", 0) == 0) {
+      return std::strtod(line.c_str() + 6, nullptr) / 1024.0;  // "VmHWM:   123456 kB"
+    }
+  }
+  return 0.0;
+}
+
 }  // namespace elastic::cli

@@ -19,4 +19,10 @@ namespace elastic::cli {
 /// madvise": printed by `elastic version` and written into every benchmark's `machine`.
 std::string allocator_description();
 
+/// The process's largest resident set so far in MiB (VmHWM of /proc/self/status; 0 where that
+/// cannot be read). Not getrusage's ru_maxrss: a process started by posix_spawn runs on its
+/// parent's memory until its exec, and Linux keeps that memory's peak in ru_maxrss, so a map
+/// spawned by `bench scale` reported the benchmark's own 10 GB at a million particles.
+double peak_resident_mib();
+
 }  // namespace elastic::cli

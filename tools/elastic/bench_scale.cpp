@@ -2,7 +2,6 @@
 
 #include <fcntl.h>
 #include <spawn.h>
-#include <sys/resource.h>
 #include <sys/wait.h>
 #include <tbb/task_arena.h>
 #include <unistd.h>
@@ -15,6 +14,7 @@
 #include <fstream>
 #include <iomanip>
 #include <iostream>
+#include <map>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <sstream>
@@ -42,7 +42,8 @@ struct ScaleArgs {
   bool quiet = false;
 };
 
-// The relaxed grid on the target as a Region (quads split along their 0-2 diagonal), for CGAL.
+// The relaxed grid on the target as a Region (quads split along their 0-2 diagonal, as
+// grid_triangles splits them), for CGAL.
 Region target_grid_region(const MapSession& session) {
   const MapResult& r = session.result;
   const ParticleGrid& grid = r.sampling.grid;
@@ -53,23 +54,14 @@ Region target_grid_region(const MapSession& session) {
     region.positions.emplace_back(x.col(p));
   }
   region.points = r.relaxation.points;
-  for (const auto f : grid.mesh.faces()) {
-    std::vector<int> v;
-    for (const auto vh : grid.mesh.fv_range(f)) {
-      v.push_back(vh.idx());
-    }
-    for (size_t k = 1; k + 1 < v.size(); ++k) {
-      region.triangles.emplace_back(v[0], v[k], v[k + 1]);
-    }
-  }
+  region.triangles = grid_triangles(grid);
   region.boundary = grid.boundary_loop;
   return region;
 }
 
 // What the operating system measured of one map's process.
 struct ProcessFigures {
-  double wall = 0.0;      ///< seconds from spawn to exit (loading of the shared libraries included)
-  double peak_mib = 0.0;  ///< largest resident set, MiB (the kernel's ru_maxrss)
+  double wall = 0.0;  ///< seconds from spawn to exit (loading of the shared libraries included)
 };
 
 // One `elastic map` of the job in a process of its own, as a user runs it: this binary again
@@ -117,11 +109,9 @@ nlohmann::json map_in_own_process(const ScaleArgs& args, long particles,
     throw IoError(exe.string(), std::string("cannot start the map: ") + std::strerror(spawned));
   }
   int status = 0;
-  rusage usage{};
-  while (wait4(pid, &status, 0, &usage) < 0 && errno == EINTR) {
+  while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {
   }
   figures.wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  figures.peak_mib = static_cast<double>(usage.ru_maxrss) / 1024.0;  // ru_maxrss is in KiB
   if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
     const std::string how = WIFEXITED(status)
                                 ? "exited with code " + std::to_string(WEXITSTATUS(status))
@@ -138,6 +128,10 @@ nlohmann::json map_in_own_process(const ScaleArgs& args, long particles,
   return out;
 }
 
+// The map report's stages (seconds.*) the table shows, in the order they run; `total` first.
+constexpr const char* kStages[] = {"total",     "loading",      "sampling", "coarse_start",
+                                   "naive_map", "solver_setup", "solve",    "mapping"};
+
 // Each timed run is a whole `elastic map` in its own process (map_in_own_process): a map repeated
 // in one process runs warm (memory already faulted in, threads started) and read 2x faster than a
 // user's `elastic map` at 5,775 particles. The grid CGAL flattens comes from one more map in this
@@ -152,7 +146,8 @@ nlohmann::json run_size(long particles, const ScaleArgs& args) {
   job.threads = args.threads;
   job.quiet = true;
   nlohmann::json out = {{"requested_particles", particles}};
-  std::vector<double> process, peak, total, loading, sampling, naive, solve, lscm;
+  std::vector<double> process, peak, lscm;
+  std::map<std::string, std::vector<double>> stages;  // the report's seconds.*, by key
   {
     const std::unique_ptr<MapSession> s = run_map_job(job);
     const Region grid = target_grid_region(*s);
@@ -180,20 +175,18 @@ nlohmann::json run_size(long particles, const ScaleArgs& args) {
     const nlohmann::json r = map_in_own_process(args, particles, report, figures);
     const nlohmann::json& t = r["seconds"];
     process.push_back(figures.wall);
-    peak.push_back(figures.peak_mib);
-    total.push_back(t.value("total", 0.0));
-    loading.push_back(t.value("loading", 0.0));
-    sampling.push_back(t.value("sampling", 0.0));
-    naive.push_back(t.value("naive_map", 0.0));
-    solve.push_back(t.value("solve", 0.0));
+    peak.push_back(r.value("peak_mib", 0.0));  // the child's own VmHWM (peak_resident_mib)
+    for (const char* key : kStages) {
+      stages[key].push_back(t.value(key, 0.0));
+    }
     out["particles"] = r.value("particles", 0L);
     out["converged"] = r.value("converged", false);
     out["folds"] = r.value("folds", -1);
   }
-  out["seconds"] = {{"process", median(process)}, {"total", median(total)},
-                    {"loading", median(loading)}, {"sampling", median(sampling)},
-                    {"naive_map", median(naive)}, {"solve", median(solve)},
-                    {"lscm", median(lscm)}};
+  out["seconds"] = {{"process", median(process)}, {"lscm", median(lscm)}};
+  for (const char* key : kStages) {
+    out["seconds"][key] = median(stages[key]);
+  }
   out["peak_mib"] = median(peak);
   out["ratio"] = median(process) / median(lscm);
   return out;
@@ -214,16 +207,23 @@ int run_scale(const ScaleArgs& args, const CLI::App& sub) {
     }
   });
   std::ostringstream table;
-  table << "| particles | process | total | loading | sampling | naive map | solve | CGAL LSCM | "
-           "ratio | peak MiB |\n"
-        << "|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+  table << "| particles | process |";
+  for (const char* key : kStages) {
+    table << ' ' << key << " |";
+  }
+  table << " CGAL LSCM | ratio | peak MiB |\n|---:|---:|";
+  for (std::size_t k = 0; k < std::size(kStages); ++k) {
+    table << "---:|";
+  }
+  table << "---:|---:|---:|\n";
   for (const nlohmann::json& c : report["sizes"]) {
     const nlohmann::json& t = c["seconds"];
     const auto d = [](const nlohmann::json& v) { return v.get<double>(); };
-    table << std::setprecision(3) << "| " << c["particles"] << " | " << d(t["process"]) << " | "
-          << d(t["total"]) << " | " << d(t["loading"]) << " | " << d(t["sampling"]) << " | "
-          << d(t["naive_map"]) << " | " << d(t["solve"]) << " | " << d(t["lscm"]) << " | "
-          << d(c["ratio"]) << " | " << d(c["peak_mib"]) << " |\n";
+    table << std::setprecision(3) << "| " << c["particles"] << " | " << d(t["process"]) << " |";
+    for (const char* key : kStages) {
+      table << ' ' << d(t[key]) << " |";
+    }
+    table << ' ' << d(t["lscm"]) << " | " << d(c["ratio"]) << " | " << d(c["peak_mib"]) << " |\n";
   }
   write_report(args.report, report);
   std::cout << table.str();

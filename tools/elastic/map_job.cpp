@@ -11,6 +11,7 @@
 #include <optional>
 #include <sstream>
 
+#include "allocator.h"
 #include "command.h"
 #include "elastic/core/atomic_file.h"
 #include "elastic/core/error.h"
@@ -484,6 +485,7 @@ nlohmann::json map_report(const MapJob& job, const MapSession& session,
         {"solver_setup", x.setup_seconds},
         {"coarse_start", r.seconds_coarse},
         {"mapping", r.seconds_mapping}}},
+      {"peak_mib", peak_resident_mib()},
       {"energy_kind", std::string(to_string(x.energy))},
       {"angular_stiffness", x.angular_stiffness},
       {"energy",

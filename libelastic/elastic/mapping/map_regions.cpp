@@ -1,6 +1,8 @@
 #include "elastic/mapping/map_regions.h"
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <optional>
 
 #include "elastic/core/error.h"
@@ -104,6 +106,10 @@ bool uses_coarse_start(const MapOptions& options, const ParticleGrid& grid) {
          options.sampling.layout.particles / options.coarse_start_ratio >= 16;
 }
 
+MapResult map_cold(const SurfaceProjector& source, const Region& source_region,
+                   const SurfaceProjector& target, const Region& target_region,
+                   const MapOptions& options, bool top);
+
 // The coarse map of a multilevel start: the same job with 1/ratio of the particles, its stages
 // reported as "coarse <stage>" and no animation frames (they would have the coarse grid's size).
 MapResult coarse_map(const SurfaceProjector& source, const Region& source_region,
@@ -125,21 +131,23 @@ MapResult coarse_map(const SurfaceProjector& source, const Region& source_region
   };
   coarse.progress = prefixed(options.progress);
   coarse.relaxation.progress = prefixed(options.relaxation.progress);
-  return map_regions(source, source_region, target, target_region, coarse);
+  return map_cold(source, source_region, target, target_region, coarse, /*top=*/false);
 }
 
 // Starts `problem` (the naive map's) from the coarse map carried onto `grid` (prolonged_map) and
 // returns the options to relax it with. The stopping tests refer to the coarse start's gradient, as
 // a warm start's do to its previous map's (|P g| of the naive map hardly depends on the particle
 // count: 0.26, 0.24 and 0.20 at 5,777, 24,984 and 100,536 particles on Plane -> Cap). A fixed
-// boundary keeps the naive map's arc-length positions exactly. A sliding boundary is held where the
-// coarse map slid it (its parameters interpolated): on Plane -> Cap, sliding again on the fine grid
-// lowered the energy by 0.003% at 1,001,732 particles (0.013% at 100,536), for 44 iterations that
-// took two thirds of the solve. Left on the naive start (and the options as given) when a particle
-// could not be carried.
+// boundary keeps the naive map's arc-length positions exactly. On the grid the caller asked for
+// (`hold`), a sliding boundary is held where the coarse map slid it (its parameters interpolated):
+// on Plane -> Cap, sliding again on that grid lowered the energy by 0.003% at 1,001,732 particles
+// (0.013% at 100,536), for 44 iterations that took two thirds of the solve. The levels below it
+// slide from the carried start, so that the boundary is the next level's and not the coarsest's
+// (held from 15,625 particles at every level, the energy at 1M was 0.016% above the cold map's).
+// Left on the naive start (and the options as given) when a particle could not be carried.
 RelaxationOptions start_from_coarse(const ParticleGrid& grid, const MapResult& coarse,
-                                    const RelaxationOptions& options, const MapResult& result,
-                                    RelaxationProblem& problem) {
+                                    const RelaxationOptions& options, bool hold,
+                                    const MapResult& result, RelaxationProblem& problem) {
   const bool slide = options.boundary == BoundaryMode::Slide;
   const std::vector<double>& parameters = slide && !coarse.relaxation.boundary_parameters.empty()
                                               ? coarse.relaxation.boundary_parameters
@@ -152,8 +160,8 @@ RelaxationOptions start_from_coarse(const ParticleGrid& grid, const MapResult& c
   }
   RelaxationOptions held = options;
   if (slide) {
-    held.boundary = BoundaryMode::Fixed;
-    problem.boundary_parameters = std::move(boundary);  // reported as where the boundary went
+    held.boundary = hold ? BoundaryMode::Fixed : BoundaryMode::Slide;
+    problem.boundary_parameters = std::move(boundary);  // the start (held: where it went)
   }
   for (std::size_t k = 0; k < grid.boundary_loop.size(); ++k) {
     const int p = grid.boundary_loop[k];
@@ -171,11 +179,19 @@ RelaxationOptions start_from_coarse(const ParticleGrid& grid, const MapResult& c
   return held;
 }
 
-// A sliding boundary held on the fine grid where the coarse map slid it: the report says how it
-// slid there (the coarse map's slide).
-void report_coarse_slide(const RelaxationResult& coarse, RelaxationResult& relaxation) {
+// A sliding boundary held on the fine grid where the coarse map slid it: the report says how far
+// it slid from the arc-length correspondence (as a fraction of the curve, as the solver measures
+// it) and why the coarse slide stopped.
+void report_coarse_slide(const ParticleGrid& grid, const RelaxationResult& coarse,
+                         RelaxationResult& relaxation) {
   relaxation.boundary = BoundaryMode::Slide;
-  relaxation.boundary_slide = coarse.boundary_slide;
+  relaxation.boundary_slide = 0.0;
+  for (std::size_t k = 0; k < grid.boundary_loop.size(); ++k) {
+    const double d = std::abs(relaxation.boundary_parameters[k] - grid.boundary_parameter[k]);
+    const double wrapped = d - std::floor(d);
+    relaxation.boundary_slide =
+        std::max(relaxation.boundary_slide, std::min(wrapped, 1.0 - wrapped));
+  }
   relaxation.slide_iterations = 0;  // none on this grid
   relaxation.slide_reason = coarse.slide_reason;
   relaxation.boundary_residual = 0.0;
@@ -189,12 +205,11 @@ void build_mapping(const SurfaceProjector& source, const SurfaceProjector& targe
                            *result.target_disk, result.relaxation.points);
   result.seconds_mapping = seconds_since(start);
 }
-}  // namespace
 
-MapResult map_regions(const SurfaceProjector& source, const Region& source_region,
-                      const SurfaceProjector& target, const Region& target_region,
-                      const MapOptions& options) {
-  check_surfaces(source, source_region, target, target_region);
+// The cold map; `top`: the grid the caller asked for (not a multilevel start's coarse level).
+MapResult map_cold(const SurfaceProjector& source, const Region& source_region,
+                   const SurfaceProjector& target, const Region& target_region,
+                   const MapOptions& options, bool top) {
   if (options.subdivisions < 0) {
     throw InvalidInputError("subdivisions", "must be 0 or more");
   }
@@ -280,10 +295,10 @@ MapResult map_regions(const SurfaceProjector& source, const Region& source_regio
       relaxation_problem(grid, target, result.naive, result, options.rest_scale);
   if (coarse) {
     const RelaxationOptions held =
-        start_from_coarse(grid, *coarse, options.relaxation, result, problem);
+        start_from_coarse(grid, *coarse, options.relaxation, top, result, problem);
     result.relaxation = relax(problem, held);
     if (held.boundary != options.relaxation.boundary) {
-      report_coarse_slide(coarse->relaxation, result.relaxation);
+      report_coarse_slide(grid, coarse->relaxation, result.relaxation);
     }
     coarse.reset();  // its grid and mapping are not needed any more (its disk maps are ours)
     if (result.relaxation.reason != StopReason::Cancelled &&
@@ -331,6 +346,15 @@ MapResult map_regions(const SurfaceProjector& source, const Region& source_regio
   stage("mapping");
   build_mapping(source, target, result);
   return result;
+}
+
+}  // namespace
+
+MapResult map_regions(const SurfaceProjector& source, const Region& source_region,
+                      const SurfaceProjector& target, const Region& target_region,
+                      const MapOptions& options) {
+  check_surfaces(source, source_region, target, target_region);
+  return map_cold(source, source_region, target, target_region, options, /*top=*/true);
 }
 
 MapResult map_regions(const SurfaceProjector& source, const Region& source_region,
