@@ -197,6 +197,30 @@ void report_coarse_slide(const ParticleGrid& grid, const RelaxationResult& coars
   relaxation.boundary_residual = 0.0;
 }
 
+// The relaxation of a multilevel start (result.relaxation): from the coarse map carried onto
+// `grid`, or from the naive map (`problem` as given) when it could not be carried or did not
+// settle there (converged and fold-free), the time tried counting.
+void relax_from_coarse(const ParticleGrid& grid, const MapResult& coarse, const MapOptions& options,
+                       bool top, MapResult& result, RelaxationProblem& problem) {
+  const RelaxationProblem naive = problem;
+  const RelaxationOptions held =
+      start_from_coarse(grid, coarse, options.relaxation, top, result, problem);
+  result.relaxation = relax(problem, held);
+  if (held.boundary != options.relaxation.boundary) {
+    report_coarse_slide(grid, coarse.relaxation, result.relaxation);
+  }
+  if (result.relaxation.reason == StopReason::Cancelled ||
+      (result.relaxation.converged && result.relaxation.folded_faces == 0)) {
+    return;
+  }
+  const RelaxationResult tried = std::move(result.relaxation);
+  problem = naive;
+  result.relaxation = relax(problem, options.relaxation);
+  result.relaxation.iterations += tried.iterations;
+  result.relaxation.setup_seconds += tried.setup_seconds;
+  result.relaxation.solve_seconds += tried.solve_seconds;
+}
+
 // The queryable mapping of the relaxed grid (the last stage of both entry points).
 void build_mapping(const SurfaceProjector& source, const SurfaceProjector& target,
                    MapResult& result) {
@@ -206,22 +230,81 @@ void build_mapping(const SurfaceProjector& source, const SurfaceProjector& targe
   result.seconds_mapping = seconds_since(start);
 }
 
-// The cold map; `top`: the grid the caller asked for (not a multilevel start's coarse level).
-MapResult map_cold(const SurfaceProjector& source, const Region& source_region,
-                   const SurfaceProjector& target, const Region& target_region,
-                   const MapOptions& options, bool top) {
+// The options map_regions refuses, naming them.
+void check_options(const MapOptions& options) {
   if (options.subdivisions < 0) {
     throw InvalidInputError("subdivisions", "must be 0 or more");
   }
   if (options.coarse_start_above < 0 || options.coarse_start_ratio < 2) {
     throw InvalidInputError("coarse start",
-                            "needs a particle count of 0 or more and a ratio of "
-                            "at least 2");
+                            "needs a particle count of 0 or more and a ratio of at least 2");
   }
   if (options.subdivisions > 0 && options.relaxation.boundary == BoundaryMode::Slide) {
     // refine_map places new boundary particles at the source parameters' midpoints.
     throw InvalidInputError("subdivisions", "cannot be combined with a sliding boundary yet");
   }
+}
+
+// The naive map of `grid` (result.naive) on the result's disk maps, turned by the offset chosen
+// among the candidates when no anchor was given (MapOptions::choose_offset), or by the one the
+// coarse map of a multilevel start chose (its figures are then the coarse grid's).
+void place_naive(const ParticleGrid& grid, const MapOptions& options, bool anchored,
+                 const MapResult* coarse, MapResult& result) {
+  if (coarse != nullptr) {
+    result.boundary_offset = coarse->boundary_offset;
+    result.offset_chosen = coarse->offset_chosen;
+    result.offset_energy = coarse->offset_energy;
+    result.offset_energy_at_zero = coarse->offset_energy_at_zero;
+    result.offset_folds = coarse->offset_folds;
+    result.naive = naive_map(grid, *result.source_disk, *result.target_disk);
+  } else if (options.choose_offset && !anchored) {
+    BoundaryOffsetResult offset = choose_boundary_offset(
+        grid, *result.source_disk, *result.target_disk,
+        {.candidates = options.offset_candidates,
+         .energy = {.stiffness = options.relaxation.stiffness,
+                    .angular_stiffness = angular_stiffness(options.relaxation),
+                    .rest_scale = result.rest_scale}});
+    result.boundary_offset = offset.offset;
+    result.offset_chosen = true;
+    result.offset_energy = offset.energy;
+    result.offset_energy_at_zero = offset.energy_at_zero;
+    result.offset_folds = offset.folds;
+    result.naive = std::move(offset.naive);  // already placed with the chosen offset
+  } else {
+    result.naive = naive_map(grid, *result.source_disk, *result.target_disk);
+  }
+}
+
+// Subdivision (end of §4.3): refines the grid on the source and the map on the target, relaxing
+// briefly after each level. Everything in `result` then describes the refined grid.
+void subdivide(const SurfaceProjector& source, const SurfaceProjector& target,
+               const MapOptions& options, MapResult& result) {
+  const auto start = std::chrono::steady_clock::now();
+  RefineMapOptions refine;
+  refine.levels = options.subdivisions;
+  refine.relaxation = options.relaxation;
+  refine.relaxation.solver = SolverKind::Fast;
+  refine.relaxation.max_iterations = options.subdivision_iterations;
+  refine.progress = options.progress;
+  refine.name = options.sampling.layout.name;
+  RefineMapResult refined = refine_map(result.sampling.grid, result.relaxation, source,
+                                       *result.source_disk, target, *result.target_disk, refine);
+  result.coarse_relaxation = std::move(result.relaxation);
+  result.relaxation = std::move(refined.relaxation);
+  result.sampling.grid = std::move(refined.grid);
+  result.sampling.statistics = measure_sampling(result.sampling.grid, source.surface());
+  result.naive = naive_map(result.sampling.grid, *result.source_disk, *result.target_disk);
+  result.subdivisions = options.subdivisions;
+  result.subdivision_levels = std::move(refined.levels);
+  result.subdivision_iterations = refined.iterations;
+  result.seconds_subdivision = seconds_since(start);
+}
+
+// The cold map; `top`: the grid the caller asked for (not a multilevel start's coarse level).
+MapResult map_cold(const SurfaceProjector& source, const Region& source_region,
+                   const SurfaceProjector& target, const Region& target_region,
+                   const MapOptions& options, bool top) {
+  check_options(options);
   auto stage = [&](std::string_view name) {
     if (!report_progress(options.progress, {.stage = name})) {
       throw Error("map", "cancelled during " + std::string(name));
@@ -258,30 +341,8 @@ MapResult map_cold(const SurfaceProjector& source, const Region& source_region,
   // 3. Rest scale sigma between the two regions' sizes.
   result.rest_scale = region_rest_scale(options.rest_scale, source_region, target_region);
 
-  if (coarse) {
-    // The coarse map chose the offset (its disk maps carry it); its figures are the coarse grid's.
-    result.boundary_offset = coarse->boundary_offset;
-    result.offset_chosen = coarse->offset_chosen;
-    result.offset_energy = coarse->offset_energy;
-    result.offset_energy_at_zero = coarse->offset_energy_at_zero;
-    result.offset_folds = coarse->offset_folds;
-    result.naive = naive_map(grid, *result.source_disk, *result.target_disk);
-  } else if (options.choose_offset && !source_region.anchor_given && !target_region.anchor_given) {
-    BoundaryOffsetResult offset = choose_boundary_offset(
-        grid, *result.source_disk, *result.target_disk,
-        {.candidates = options.offset_candidates,
-         .energy = {.stiffness = options.relaxation.stiffness,
-                    .angular_stiffness = angular_stiffness(options.relaxation),
-                    .rest_scale = result.rest_scale}});
-    result.boundary_offset = offset.offset;
-    result.offset_chosen = true;
-    result.offset_energy = offset.energy;
-    result.offset_energy_at_zero = offset.energy_at_zero;
-    result.offset_folds = offset.folds;
-    result.naive = std::move(offset.naive);  // already placed with the chosen offset
-  } else {
-    result.naive = naive_map(grid, *result.source_disk, *result.target_disk);
-  }
+  place_naive(grid, options, source_region.anchor_given || target_region.anchor_given,
+              coarse ? &*coarse : nullptr, result);
   if (result.naive.outside > 0) {
     throw NumericalError("map", std::to_string(result.naive.outside) +
                                     " particles could not be placed in the target region");
@@ -294,24 +355,8 @@ MapResult map_cold(const SurfaceProjector& source, const Region& source_region,
   RelaxationProblem problem =
       relaxation_problem(grid, target, result.naive, result, options.rest_scale);
   if (coarse) {
-    const RelaxationOptions held =
-        start_from_coarse(grid, *coarse, options.relaxation, top, result, problem);
-    result.relaxation = relax(problem, held);
-    if (held.boundary != options.relaxation.boundary) {
-      report_coarse_slide(grid, coarse->relaxation, result.relaxation);
-    }
+    relax_from_coarse(grid, *coarse, options, top, result, problem);
     coarse.reset();  // its grid and mapping are not needed any more (its disk maps are ours)
-    if (result.relaxation.reason != StopReason::Cancelled &&
-        (!result.relaxation.converged || result.relaxation.folded_faces > 0)) {
-      // Not settled from the carried start: the naive start, as without a coarse map (the
-      // time spent counts).
-      const RelaxationResult tried = std::move(result.relaxation);
-      problem = relaxation_problem(grid, target, result.naive, result, options.rest_scale);
-      result.relaxation = relax(problem, options.relaxation);
-      result.relaxation.iterations += tried.iterations;
-      result.relaxation.setup_seconds += tried.setup_seconds;
-      result.relaxation.solve_seconds += tried.solve_seconds;
-    }
   } else {
     result.relaxation = relax(problem, options.relaxation);
   }
@@ -321,25 +366,7 @@ MapResult map_cold(const SurfaceProjector& source, const Region& source_region,
   // 5. Subdivision (end of §4.3): refine the grid on the source and the map on the target, relax
   // briefly after each level. Everything returned then describes the refined grid.
   if (options.subdivisions > 0) {
-    start = std::chrono::steady_clock::now();
-    RefineMapOptions refine;
-    refine.levels = options.subdivisions;
-    refine.relaxation = options.relaxation;
-    refine.relaxation.solver = SolverKind::Fast;
-    refine.relaxation.max_iterations = options.subdivision_iterations;
-    refine.progress = options.progress;
-    refine.name = options.sampling.layout.name;
-    RefineMapResult refined = refine_map(grid, result.relaxation, source, *result.source_disk,
-                                         target, *result.target_disk, refine);
-    result.coarse_relaxation = std::move(result.relaxation);
-    result.relaxation = std::move(refined.relaxation);
-    result.sampling.grid = std::move(refined.grid);
-    result.sampling.statistics = measure_sampling(result.sampling.grid, source.surface());
-    result.naive = naive_map(result.sampling.grid, *result.source_disk, *result.target_disk);
-    result.subdivisions = options.subdivisions;
-    result.subdivision_levels = std::move(refined.levels);
-    result.subdivision_iterations = refined.iterations;
-    result.seconds_subdivision = seconds_since(start);
+    subdivide(source, target, options, result);
   }
 
   // 6. The queryable mapping.

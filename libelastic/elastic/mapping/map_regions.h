@@ -58,10 +58,12 @@ struct MapOptions {
   /// particles relaxes from the relaxed map of a grid of 1/`coarse_start_ratio` as many particles
   /// of the same source region (mapped by these options, so a million particles go through 125,000
   /// and 15,625), carried onto it by prolonged_map (mapping/initial_map.h), instead of from the
-  /// naive map. The coarse map decides the boundary offset and, with a sliding boundary, where the
-  /// boundary goes; the fine grid only adds its detail. On the Plane -> Cap benchmark at 1,001,732
-  /// particles the naive start's slide crept for 222 iterations at 0.7 s each, its first ring
-  /// crowded against the hemisphere's rim (docs/results.md, Speed). 0: never.
+  /// naive map. The coarsest map decides the boundary offset. A sliding boundary slides on each
+  /// coarse level from the one below; this grid holds it where the level below slid it and only
+  /// its interior relaxes (RelaxationResult::slide_iterations is then 0). On the Plane -> Cap
+  /// benchmark at 1,001,732 particles the naive start's slide crept for 222 iterations at 0.7 s
+  /// each, its first ring crowded against the hemisphere's rim: 186 s for the whole map, 21 s with
+  /// this start, the energy 0.003% above (docs/results.md, Speed). 0: never.
   int coarse_start_above = 50000;
   /// Particles of the fine grid per particle of the coarse one (at least 2).
   int coarse_start_ratio = 8;
