@@ -11,22 +11,20 @@
 #include "elastic/mapping/map_regions.h"
 #include "elastic/regions/region_spec.h"
 #include "elastic/shapes/procedural_shapes.h"
+#include "mapping/disk_onto_sphere.h"
 
 namespace elastic {
 namespace {
 
-// A plane disk onto a disk of the unit sphere (the warm start tests' case).
-struct DiskOntoSphere {
-  LimitSurface plane_surface{make_plane({.resolution = 12})};
-  LimitSurface sphere_surface{make_sphere({.resolution = 24})};
-  SurfaceProjector source{plane_surface}, target{sphere_surface};
-  Region from = make_region(source, parse_region_spec("disk:0,0,0,0.6"));
-  Region to = make_region(target, parse_region_spec("disk:0,0,1,0.5"));
+using test::boundary_name;
+
+// The plane disk onto the sphere's disk of radius 0.5 around +z, without the multilevel start
+// unless a test sets it.
+struct DiskOntoSphere : test::DiskOntoSphere {
+  Region to = sphere_disk(0.0, 0.5);
 
   static MapOptions options(long particles, BoundaryMode boundary) {
-    MapOptions o;
-    o.sampling.layout.particles = particles;
-    o.relaxation.boundary = boundary;
+    MapOptions o = test::DiskOntoSphere::options(boundary, particles);
     o.coarse_start_above = 0;
     return o;
   }
@@ -140,10 +138,6 @@ TEST_P(CoarseStart, ReachesTheColdMapsEnergy) {
     EXPECT_EQ(multilevel.relaxation.slide_iterations, 0);  // it slid on the coarse grid
     EXPECT_EQ(multilevel.relaxation.boundary_parameters.size(), grid.boundary_loop.size());
   }
-}
-
-std::string boundary_name(const ::testing::TestParamInfo<BoundaryMode>& param) {
-  return param.param == BoundaryMode::Slide ? "Slide" : "Fixed";
 }
 
 INSTANTIATE_TEST_SUITE_P(BothBoundaries, CoarseStart,

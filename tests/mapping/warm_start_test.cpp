@@ -10,30 +10,13 @@
 #include "elastic/mapping/map_regions.h"
 #include "elastic/regions/region_spec.h"
 #include "elastic/shapes/procedural_shapes.h"
+#include "mapping/disk_onto_sphere.h"
 
 namespace elastic {
 namespace {
 
-// A plane disk onto a disk of the unit sphere around a direction `tilt` radians from +z towards
-// +x; the regions are made by the tests.
-struct DiskOntoSphere {
-  LimitSurface plane_surface{make_plane({.resolution = 12})};
-  LimitSurface sphere_surface{make_sphere({.resolution = 24})};
-  SurfaceProjector source{plane_surface}, target{sphere_surface};
-  Region from = make_region(source, parse_region_spec("disk:0,0,0,0.6"));
-
-  Region sphere_disk(double tilt, double radius) const {
-    return make_region(
-        target, parse_region_spec("disk:" + std::to_string(std::sin(tilt)) + ",0," +
-                                  std::to_string(std::cos(tilt)) + "," + std::to_string(radius)));
-  }
-  static MapOptions options(BoundaryMode boundary) {
-    MapOptions o;
-    o.sampling.layout.particles = 600;
-    o.relaxation.boundary = boundary;
-    return o;
-  }
-};
+using test::boundary_name;
+using test::DiskOntoSphere;
 
 // Carried from a region to itself, every particle stays where it was (the disk map and its
 // inverse agree to round-off).
@@ -135,10 +118,6 @@ TEST_P(WarmStart, StoppedWarmStartsChain) {
     return r.length_energy + r.angular_energy + r.barrier_energy;
   };
   EXPECT_NEAR(energy(resumed.relaxation), energy(full.relaxation), 0.01 * energy(full.relaxation));
-}
-
-std::string boundary_name(const ::testing::TestParamInfo<BoundaryMode>& param) {
-  return param.param == BoundaryMode::Fixed ? "Fixed" : "Slide";
 }
 
 INSTANTIATE_TEST_SUITE_P(BothBoundaries, WarmStart,
