@@ -144,6 +144,25 @@ INSTANTIATE_TEST_SUITE_P(BothBoundaries, CoarseStart,
                          ::testing::Values(BoundaryMode::Slide, BoundaryMode::Fixed),
                          boundary_name);
 
+// A carried start that does not settle (here: an iteration budget of 2) is not returned: the map
+// relaxes again from the naive start, exactly as without the coarse map (no offset search, so both
+// naive maps are the same), and the iterations tried count.
+TEST(CoarseStart, UnsettledCarriedStartFallsBackToTheNaiveStart) {
+  const DiskOntoSphere c;
+  MapOptions options = c.options(3000, BoundaryMode::Slide);
+  options.choose_offset = false;
+  options.relaxation.max_iterations = 2;
+  const MapResult cold = map_regions(c.source, c.from, c.target, c.to, options);
+  options.coarse_start_above = 1000;
+  const MapResult multilevel = map_regions(c.source, c.from, c.target, c.to, options);
+  ASSERT_FALSE(cold.relaxation.converged);
+  EXPECT_FALSE(multilevel.relaxation.converged);
+  EXPECT_GT(multilevel.coarse_particles, 0);
+  EXPECT_EQ(multilevel.relaxation.positions, cold.relaxation.positions);
+  EXPECT_EQ(multilevel.relaxation.initial_energy, cold.relaxation.initial_energy);
+  EXPECT_GT(multilevel.relaxation.iterations, cold.relaxation.iterations);
+}
+
 // Below the threshold, with the faithful solver or with subdivision, the map is the cold one to
 // the bit; a negative threshold or a ratio below 2 is refused, naming the option.
 TEST(CoarseStartInput, OnlyWhereItAppliesAndRefusesNonsense) {
