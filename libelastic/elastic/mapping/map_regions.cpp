@@ -1,11 +1,10 @@
 #include "elastic/mapping/map_regions.h"
 
-#include <algorithm>
 #include <chrono>
-#include <cmath>
 #include <optional>
 
 #include "elastic/core/error.h"
+#include "elastic/solvers/solver_common.h"
 
 namespace elastic {
 
@@ -185,13 +184,8 @@ RelaxationOptions start_from_coarse(const ParticleGrid& grid, const MapResult& c
 void report_coarse_slide(const ParticleGrid& grid, const RelaxationResult& coarse,
                          RelaxationResult& relaxation) {
   relaxation.boundary = BoundaryMode::Slide;
-  relaxation.boundary_slide = 0.0;
-  for (std::size_t k = 0; k < grid.boundary_loop.size(); ++k) {
-    const double d = std::abs(relaxation.boundary_parameters[k] - grid.boundary_parameter[k]);
-    const double wrapped = d - std::floor(d);
-    relaxation.boundary_slide =
-        std::max(relaxation.boundary_slide, std::min(wrapped, 1.0 - wrapped));
-  }
+  relaxation.boundary_slide =
+      solver_detail::boundary_slide(grid.boundary_parameter, relaxation.boundary_parameters);
   relaxation.slide_iterations = 0;  // none on this grid
   relaxation.slide_reason = coarse.slide_reason;
   relaxation.boundary_residual = 0.0;
