@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <random>
@@ -527,6 +528,58 @@ TEST(LimitSurface, SharedSpotControlMesh) {
   EXPECT_EQ(s.scheme(), SubdivisionScheme::CatmullClark);
   EXPECT_EQ(s.num_faces(), 160 + 4 * 3 + 16 * 5);
   expect_limit_consistent(s);
+}
+
+TEST(LimitSurface, SmoothIsolationDepthDefaultsByMeshSize) {
+  // Up to kDenseMeshFaces control faces the smooth extraordinary vertices get the full depth; a
+  // larger mesh gets 2; an explicit value wins, and one outside 1..isolation_level is refused.
+  const LimitSurface small(quad_grid(100, 100, {0, 0, 0}, {1, 0, 0}, {0, 1, 0}), {});
+  EXPECT_EQ(small.smooth_isolation_level(), 6);
+  const LimitSurface dense(quad_grid(161, 160, {0, 0, 0}, {1, 0, 0}, {0, 1, 0}), {});
+  ASSERT_GT(dense.num_faces(), kDenseMeshFaces);
+  EXPECT_EQ(dense.smooth_isolation_level(), 2);
+  const LimitSurface chosen(quad_grid(161, 160, {0, 0, 0}, {1, 0, 0}, {0, 1, 0}),
+                            {.smooth_isolation_level = 5});
+  EXPECT_EQ(chosen.smooth_isolation_level(), 5);
+  const PolygonMesh grid = quad_grid(4, 4, {0, 0, 0}, {1, 0, 0}, {0, 1, 0});
+  for (const int bad : {0, -2, 7}) {
+    EXPECT_THROW(LimitSurface(grid, {.smooth_isolation_level = bad}), InvalidInputError) << bad;
+  }
+  EXPECT_THROW(LimitSurface(grid, {.isolation_level = 3, .smooth_isolation_level = 4}),
+               InvalidInputError);
+}
+
+TEST(LimitSurface, ShallowSmoothIsolationStaysCloseToTheDeepLimit) {
+  // The documented price of depth 2 on a real mesh (LimitSurfaceOptions::smooth_isolation_level):
+  // positions within 1e-3 of the bounding box's diagonal of depth 6 at random points, and the
+  // option takes effect (the surfaces differ near extraordinary vertices).
+  ELASTIC_REQUIRE_SHARED_MESH(path, "bob_tri.obj");
+  const PolygonMesh mesh = read_mesh(path).mesh;
+  const LimitSurface deep(mesh, {.smooth_isolation_level = 6});
+  const LimitSurface shallow(mesh, {.smooth_isolation_level = 2});
+  EXPECT_EQ(deep.smooth_isolation_level(), 6);
+  Eigen::Vector3d lo = mesh.positions.front(), hi = lo;
+  for (const Eigen::Vector3d& p : mesh.positions) {
+    lo = lo.cwiseMin(p);
+    hi = hi.cwiseMax(p);
+  }
+  const double diagonal = (hi - lo).norm();
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  double largest = 0.0;
+  for (int i = 0; i < 20000; ++i) {
+    SurfacePoint q;
+    q.face = static_cast<int>(rng() % static_cast<unsigned>(deep.num_faces()));
+    q.u = unit(rng);
+    q.v = unit(rng);
+    if (q.u + q.v > 1.0) {  // Loop: the ptex triangle u + v <= 1
+      q.u = 1.0 - q.u;
+      q.v = 1.0 - q.v;
+    }
+    largest = std::max(largest, (deep.position(q) - shallow.position(q)).norm());
+  }
+  EXPECT_LT(largest, 1e-3 * diagonal);
+  EXPECT_GT(largest, 1e-7 * diagonal);
 }
 
 TEST(LimitSurface, SharedNonManifoldMeshIsRejected) {

@@ -130,6 +130,13 @@ void LimitSurface::Impl::validate_topology(const LimitSurfaceOptions& options) {
   if (options.isolation_level < 1 || options.isolation_level > 10) {
     fail("isolation_level " + std::to_string(options.isolation_level) + " is out of range 1..10");
   }
+  if (options.smooth_isolation_level != -1 &&
+      (options.smooth_isolation_level < 1 ||
+       options.smooth_isolation_level > options.isolation_level)) {
+    fail("smooth_isolation_level " + std::to_string(options.smooth_isolation_level) +
+         " is out of range 1..isolation_level (" + std::to_string(options.isolation_level) +
+         ") or -1");
+  }
   const int nf = mesh.num_faces();
   if (nf > 0 &&
       (static_cast<int>(mesh.face_offsets.size()) != nf + 1 || mesh.face_offsets.front() != 0 ||
@@ -269,7 +276,11 @@ LimitSurface::LimitSurface(const PolygonMesh& mesh, const LimitSurfaceOptions& o
   m.validate_topology(options);
   m.build_refiner(options);
   m.build_ptex_numbering();
-  m.build_patches(options.isolation_level);
+  m.smooth_isolation_level = options.smooth_isolation_level != -1 ? options.smooth_isolation_level
+                             : mesh.num_faces() > kDenseMeshFaces
+                                 ? std::min(2, options.isolation_level)
+                                 : options.isolation_level;
+  m.build_patches(options.isolation_level, m.smooth_isolation_level);
   if (m.patch_table->GetNumPtexFaces() != static_cast<int>(m.ptex_to_control.size())) {
     m.fail("OpenSubdiv's patch table and ptex indices disagree on the number of ptex faces");
   }
@@ -288,6 +299,10 @@ const std::string& LimitSurface::name() const {
 }
 int LimitSurface::num_faces() const {
   return static_cast<int>(impl_->ptex_to_control.size());
+}
+
+int LimitSurface::smooth_isolation_level() const {
+  return impl_->smooth_isolation_level;
 }
 
 int LimitSurface::control_face(int ptex_face) const {

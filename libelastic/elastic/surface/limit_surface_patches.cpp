@@ -144,7 +144,7 @@ size_t gathered_size(const Far::PatchTable& table) {
 
 }  // namespace
 
-void LimitSurface::Impl::build_patches(int isolation_level) {
+void LimitSurface::Impl::build_patches(int isolation_level, int smooth_isolation_level) {
   Far::PatchTableFactory::Options patch_options(static_cast<unsigned int>(isolation_level));
   patch_options.SetPatchPrecision<double>();
   // Gregory basis end caps around extraordinary vertices; for Loop the factory makes them Gregory
@@ -153,7 +153,9 @@ void LimitSurface::Impl::build_patches(int isolation_level) {
   patch_options.generateVaryingTables = false;
   patch_options.generateVaryingLocalPoints = false;
 
-  refiner->RefineAdaptive(patch_options.GetRefineAdaptiveOptions());
+  Far::TopologyRefiner::AdaptiveOptions adaptive = patch_options.GetRefineAdaptiveOptions();
+  adaptive.SetSecondaryLevel(smooth_isolation_level);
+  refiner->RefineAdaptive(adaptive);
   patch_table.reset(Far::PatchTableFactory::Create(*refiner, patch_options));
   if (!patch_table) {
     fail("OpenSubdiv could not build the patch table");

@@ -102,6 +102,7 @@ struct LimitSurface::Impl {
 
   PolygonMesh mesh;
   std::string name;
+  int smooth_isolation_level = 0;  ///< the secondary isolation level used
   SubdivisionScheme scheme = SubdivisionScheme::CatmullClark;
   bool triangle = false;
   PtexDomain domain{false};  ///< the ptex faces' parameter domain (triangle for Loop)
@@ -132,7 +133,7 @@ struct LimitSurface::Impl {
   void build_refiner(const LimitSurfaceOptions& options);
   void check_refiner_manifold() const;
   void build_ptex_numbering();
-  void build_patches(int isolation_level);
+  void build_patches(int isolation_level, int smooth_isolation_level);
   void build_adjacency();
 
   void check_point(const SurfacePoint& p) const {
