@@ -45,21 +45,30 @@ std::vector<std::string> subcommands(const fs::path& dir) {
   const auto list = [&](const std::string& help) {
     std::vector<std::string> found;
     const size_t at = help.find("Subcommands:");
-    if (at == std::string::npos) return found;
+    if (at == std::string::npos) {
+      return found;
+    }
     std::istringstream lines(help.substr(at));
     std::string line;
     std::getline(lines, line);
     while (std::getline(lines, line)) {
       std::istringstream words(line);
       std::string word;
-      if (words >> word) found.push_back(word);
+      if (words >> word) {
+        found.push_back(word);
+      }
     }
     return found;
   };
   for (const std::string& top : list(elastic("--help", dir).out)) {
     const std::vector<std::string> nested = list(elastic(top + " --help", dir).out);
-    if (nested.empty()) names.push_back(top);
-    for (const std::string& n : nested) names.push_back(top + " " + n);
+    if (nested.empty()) {
+      names.push_back(top);
+    }
+    for (const std::string& n : nested) {
+      names.push_back(top);
+      names.back().append(" ").append(n);
+    }
   }
   return names;
 }
@@ -137,6 +146,10 @@ TEST(Grammar, ResolutionsHaveOneNameEachAndTheOldOneStillWorks) {
           .code,
       0);
   EXPECT_EQ(test::slurp(dir / "r.json"), test::slurp(dir / "j.json"));
+  // It says how deep the limit surface was refined (a small mesh: everywhere the full depth).
+  const nlohmann::json facts = nlohmann::json::parse(std::ifstream(dir / "r.json"));
+  EXPECT_EQ(facts.at("limit_surface").at("isolation_level"), 6);
+  EXPECT_EQ(facts.at("limit_surface").at("smooth_isolation_level"), 6);
   // A shape flag is not an info flag.
   EXPECT_EQ(elastic("info --segments 2 " + mesh("plane_quads.obj"), dir).code, 64);
 }
@@ -152,10 +165,15 @@ TEST(Grammar, ParticlesOutOfRangeIsTheSameUsageErrorEverywhere) {
         elastic("sample --source " + mesh("plane_quads.obj") + " --source-region boundary" + p,
                 dir),
         64, "--particles");
-    expect_one_line_error(elastic("map" + source + p, dir), 64, "--particles");
-    expect_one_line_error(elastic("compare" + source + p, dir), 64, "--particles");
-    expect_one_line_error(elastic("paste" + source + p + " --out " + (dir / "out").string(), dir),
-                          64, "--particles");
+    for (const char* command : {"map", "compare"}) {
+      expect_one_line_error(elastic(std::string(command).append(source).append(p), dir), 64,
+                            "--particles");
+    }
+    expect_one_line_error(
+        elastic(std::string("paste").append(source).append(p).append(" --out ").append(
+                    (dir / "out").string()),
+                dir),
+        64, "--particles");
   }
   // In a job file too.
   std::ofstream(dir / "job.json") << R"({"command": "map", "particles": 0})";

@@ -34,7 +34,9 @@ bool away_from_patch_seams(double u, double v, bool triangle, int level, double 
     const double f = x * scale - std::floor(x * scale);
     return f > margin && f < 1.0 - margin;
   };
-  if (!far_from_grid(u) || !far_from_grid(v)) return false;
+  if (!far_from_grid(u) || !far_from_grid(v)) {
+    return false;
+  }
   return !triangle || (far_from_grid(u + v) && u + v < 1.0 - margin / scale);
 }
 
@@ -49,8 +51,12 @@ std::vector<SurfacePoint> sample_points(const LimitSurface& s, int per_face, uns
     int added = 0;
     while (added < per_face) {
       const double u = uni(rng), v = uni(rng);
-      if (tri && u + v > 1.0) continue;
-      if (!away_from_patch_seams(u, v, tri, 6, 0.05)) continue;
+      if (tri && u + v > 1.0) {
+        continue;
+      }
+      if (!away_from_patch_seams(u, v, tri, 6, 0.05)) {
+        continue;
+      }
       out.push_back({f, u, v});
       ++added;
     }
@@ -81,7 +87,9 @@ void expect_derivatives_match_differences(const LimitSurface& s,
   const double h = 1e-6;
   const double position_scale = [&] {
     double m = 1.0;
-    for (const auto& p : s.control_mesh().positions) m = std::max(m, p.norm());
+    for (const auto& p : s.control_mesh().positions) {
+      m = std::max(m, p.norm());
+    }
     return m;
   }();
   int checked = 0;
@@ -196,7 +204,9 @@ TEST(LimitSurface, NgonSubFacesFollowTheDocumentedConvention) {
     // The sub-face corner lies closer to its own control vertex than to any other of the pentagon.
     const Eigen::Vector3d x = s.position({a, 0, 0});
     for (int j = 0; j < 5; ++j) {
-      if (j == i) continue;
+      if (j == i) {
+        continue;
+      }
       EXPECT_LT(
           (x - mesh.positions[static_cast<size_t>(vertex)]).norm(),
           (x - mesh.positions[static_cast<size_t>(mesh.face(0)[static_cast<size_t>(j)])]).norm());
@@ -207,7 +217,9 @@ TEST(LimitSurface, NgonSubFacesFollowTheDocumentedConvention) {
     const int count = (f + 1 < mesh.num_faces() ? s.first_ptex_face(f + 1) : s.num_faces()) -
                       s.first_ptex_face(f);
     EXPECT_EQ(count, n == 4 ? 1 : n);
-    for (int k = 0; k < count; ++k) EXPECT_EQ(s.control_face(s.first_ptex_face(f) + k), f);
+    for (int k = 0; k < count; ++k) {
+      EXPECT_EQ(s.control_face(s.first_ptex_face(f) + k), f);
+    }
   }
 }
 
@@ -287,11 +299,17 @@ TEST(LimitSurface, OpenGridBoundaryLimitLiesOnTheControlBoundaryLines) {
   std::uniform_real_distribution<double> uni(-0.3, 0.3);
   for (int j = 0; j <= 5; ++j) {
     for (int i = 0; i <= 5; ++i) {
-      Eigen::Vector3d& p = mesh.positions[static_cast<size_t>(j * 6 + i)];
+      Eigen::Vector3d& p = mesh.positions[static_cast<size_t>(j) * 6 + static_cast<size_t>(i)];
       const bool bi = i == 0 || i == 5, bj = j == 0 || j == 5;
-      if (!bi) p.x() += uni(rng);
-      if (!bj) p.y() += uni(rng);
-      if (!bi && !bj) p.z() += uni(rng);
+      if (!bi) {
+        p.x() += uni(rng);
+      }
+      if (!bj) {
+        p.y() += uni(rng);
+      }
+      if (!bi && !bj) {
+        p.z() += uni(rng);
+      }
     }
   }
   const LimitSurface s(mesh, {.name = "open grid"});
@@ -305,7 +323,9 @@ TEST(LimitSurface, OpenGridBoundaryLimitLiesOnTheControlBoundaryLines) {
       const double t = k / 20.0;
       for (const SurfacePoint& p : {SurfacePoint{f, t, 0}, SurfacePoint{f, 1, t},
                                     SurfacePoint{f, t, 1}, SurfacePoint{f, 0, t}}) {
-        if (!s.on_boundary(p)) continue;
+        if (!s.on_boundary(p)) {
+          continue;
+        }
         ++checked;
         const Eigen::Vector3d x = s.position(p);
         const double side =
@@ -367,7 +387,9 @@ void expect_sphere_curvature(const LimitSurface& s, double tolerance) {
   for (const SurfacePoint& p : sample_points(s, 2, 21)) {
     const SurfaceDerivatives d = s.derivatives(p);
     const double r = d.position.norm();
-    if (std::abs(d.position.z()) > band * r) continue;  // polar caps: see the test's comment
+    if (std::abs(d.position.z()) > band * r) {
+      continue;  // polar caps: see the test's comment
+    }
     const SurfaceCurvature k = s.curvature(d);
     EXPECT_NEAR(k.k1 * r, 1.0, tolerance) << "face " << p.face << " (" << p.u << ", " << p.v << ")";
     EXPECT_NEAR(k.k2 * r, 1.0, tolerance) << "face " << p.face << " (" << p.u << ", " << p.v << ")";
@@ -498,9 +520,13 @@ TEST(LimitSurface, SharedCube) {
   // The file's coordinates are rounded to 6 decimals (1.414214 for sqrt 2), so the cube is
   // symmetric to ~1e-6 only.
   Eigen::Vector3d centre = Eigen::Vector3d::Zero();
-  for (const auto& p : mesh.positions) centre += p / mesh.num_vertices();
+  for (const auto& p : mesh.positions) {
+    centre += p / mesh.num_vertices();
+  }
   const double r0 = (s.position(s.face_center(0)) - centre).norm();
-  for (int f = 1; f < 6; ++f) EXPECT_NEAR((s.position(s.face_center(f)) - centre).norm(), r0, 2e-6);
+  for (int f = 1; f < 6; ++f) {
+    EXPECT_NEAR((s.position(s.face_center(f)) - centre).norm(), r0, 2e-6);
+  }
 }
 
 TEST(LimitSurface, SharedPawnWithCreases) {

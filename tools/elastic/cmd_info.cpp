@@ -36,13 +36,17 @@ struct Stats {
 
 Stats stats_of(std::vector<double> values) {
   Stats s;
-  if (values.empty()) return s;
+  if (values.empty()) {
+    return s;
+  }
   std::sort(values.begin(), values.end());
   s.min = values.front();
   s.max = values.back();
   s.median = values[values.size() / 2];
   double sum = 0;
-  for (double v : values) sum += v;
+  for (double v : values) {
+    sum += v;
+  }
   s.mean = sum / static_cast<double>(values.size());
   return s;
 }
@@ -71,7 +75,9 @@ CurvatureSurvey survey_curvature(const LimitSurface& surface, const LimitTessell
     const double a = 0.5 * (tess.positions[t[1]] - tess.positions[t[0]])
                                .cross(tess.positions[t[2]] - tess.positions[t[0]])
                                .norm();
-    for (int k = 0; k < 3; ++k) area[t[k]] += a / 3.0;
+    for (int k = 0; k < 3; ++k) {
+      area[t[k]] += a / 3.0;
+    }
   }
   for (size_t i = 0; i < n; ++i) {
     const SurfaceCurvature k = surface.curvature(tess.points[i]);
@@ -105,6 +111,8 @@ struct InfoFacts {
   std::vector<std::string> warnings;
   const char* scheme = "";
   int ptex_faces = 0;
+  int isolation_level = 0;         // adaptive refinement depth at creases and corners
+  int smooth_isolation_level = 0;  // ... and around smooth extraordinary vertices
   size_t tessellation_triangles = 0;
   CurvatureSurvey curvature;
   UpAxisGuess up;
@@ -141,6 +149,8 @@ nlohmann::json info_report(const InfoFacts& f) {
           {"limit_surface",
            {{"scheme", f.scheme},
             {"ptex_faces", f.ptex_faces},
+            {"isolation_level", f.isolation_level},
+            {"smooth_isolation_level", f.smooth_isolation_level},
             {"tessellation_triangles", f.tessellation_triangles},
             {"area", c.total_area},
             {"bbox_min", {c.lo.x(), c.lo.y(), c.lo.z()}},
@@ -170,7 +180,9 @@ void print_info(const InfoFacts& f) {
             << " edges, " << v.num_boundary_loops << " boundary loops, " << v.num_components
             << " component(s), chi = " << v.euler_characteristic << ", genus " << v.genus << '\n';
   if (!f.args->quiet) {
-    for (const std::string& w : f.warnings) std::cout << "  warning: " << w << '\n';
+    for (const std::string& w : f.warnings) {
+      std::cout << "  warning: " << w << '\n';
+    }
   }
   const auto xyz = [](const Eigen::Vector3d& p) {
     std::ostringstream text;
@@ -183,7 +195,9 @@ void print_info(const InfoFacts& f) {
             << "  up axis (guessed): " << f.up.name() << ", confidence "
             << to_string(f.up.confidence) << ": " << f.up.reason
             << "; previews take --up to overrule it\n";
-  std::cout << "limit surface: " << f.scheme << ", " << f.ptex_faces << " ptex faces, area "
+  std::cout << "limit surface: " << f.scheme << ", " << f.ptex_faces
+            << " ptex faces, isolated to depth " << f.isolation_level
+            << " (smooth extraordinary vertices " << f.smooth_isolation_level << "), area "
             << std::setprecision(6) << c.total_area << ", curvature over " << c.vertices
             << " tessellation vertices:\n";
   line("k1", stats_of(c.k1));
@@ -217,19 +231,27 @@ int run_info(const InfoArgs& args) {
 
   LimitSurfaceOptions options;
   options.name = args.mesh;
-  if (args.scheme == "loop") options.scheme = SubdivisionScheme::Loop;
-  if (args.scheme == "catmull-clark") options.scheme = SubdivisionScheme::CatmullClark;
+  if (args.scheme == "loop") {
+    options.scheme = SubdivisionScheme::Loop;
+  }
+  if (args.scheme == "catmull-clark") {
+    options.scheme = SubdivisionScheme::CatmullClark;
+  }
   const LimitSurface surface(mesh, options);
   const LimitTessellation tess = tessellate(surface, {.resolution = args.resolution});
   f.curvature = survey_curvature(surface, tess);
   f.scheme = surface.scheme() == SubdivisionScheme::Loop ? "loop" : "catmull-clark";
   f.ptex_faces = surface.num_faces();
+  f.isolation_level = options.isolation_level;
+  f.smooth_isolation_level = surface.smooth_isolation_level();
   f.tessellation_triangles = tess.triangles.size();
 
   // Which way is up (render/up_axis.h: the side the model stands on, its open end, its height
   // field, or the +y convention, and how sure that is), from the control mesh.
   f.up = guess_up_axis(mesh);
-  for (const Eigen::Vector3d& p : mesh.positions) f.control_box.extend(p);
+  for (const Eigen::Vector3d& p : mesh.positions) {
+    f.control_box.extend(p);
+  }
 
   if (!args.json.empty()) {
     const nlohmann::json report = info_report(f);

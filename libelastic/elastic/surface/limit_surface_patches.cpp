@@ -109,7 +109,7 @@ PatchRecord patch_record(Far::PatchDescriptor::Type type, const Far::PatchParam&
 /// in any order.
 void substitute_phantom_points(std::array<Eigen::Vector3d, 16>& p, int boundary) {
   auto at = [&](int row, int col) -> Eigen::Vector3d& {
-    return p[static_cast<size_t>(4 * row + col)];
+    return p[4 * static_cast<size_t>(row) + static_cast<size_t>(col)];
   };
   for (int j = 0; j < 4; ++j) {
     if (boundary & 8) {
