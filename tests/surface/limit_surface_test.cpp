@@ -10,6 +10,7 @@
 #include <numbers>
 #include <random>
 #include <string>
+#include <vector>
 
 #include "elastic/core/error.h"
 #include "elastic/mesh/mesh_io.h"
@@ -573,6 +574,45 @@ TEST(LimitSurface, SmoothIsolationDepthDefaultsByMeshSize) {
   }
   EXPECT_THROW(LimitSurface(grid, {.isolation_level = 3, .smooth_isolation_level = 4}),
                InvalidInputError);
+}
+
+TEST(LimitSurface, ShallowSmoothIsolationKeepsLoopsLimitPoints) {
+  // An independent answer at the extraordinary vertices themselves, where the shallow depth leaves
+  // the largest Gregory end caps: the Gregory corners interpolate the limit point, which for Loop
+  // is (1 - n chi) x + chi sum of the ring, chi = 1 / (3 / (8 beta) + n), beta = (5/8 - (3/8 +
+  // cos(2 pi / n) / 4)^2) / n (Loop 1987). An icosphere has valence-5 and valence-6 vertices.
+  const PolygonMesh mesh = test::icosphere(2, 1.0);
+  std::vector<std::vector<int>> ring(static_cast<size_t>(mesh.num_vertices()));
+  for (int f = 0; f < mesh.num_faces(); ++f) {
+    const auto fv = mesh.face(f);
+    for (size_t c = 0; c < 3; ++c) {
+      std::vector<int>& r = ring[static_cast<size_t>(fv[c])];
+      const int next = fv[(c + 1) % 3];
+      if (std::find(r.begin(), r.end(), next) == r.end()) {
+        r.push_back(next);
+      }
+    }
+  }
+  for (const int depth : {2, 6}) {
+    const LimitSurface s(mesh, {.smooth_isolation_level = depth});
+    ASSERT_EQ(s.smooth_isolation_level(), depth);
+    int extraordinary = 0;
+    for (int v = 0; v < mesh.num_vertices(); ++v) {
+      const std::vector<int>& r = ring[static_cast<size_t>(v)];
+      const double n = static_cast<double>(r.size());
+      const double a = 3.0 / 8.0 + 0.25 * std::cos(2.0 * std::numbers::pi / n);
+      const double beta = (5.0 / 8.0 - a * a) / n;
+      const double chi = 1.0 / (3.0 / (8.0 * beta) + n);
+      Eigen::Vector3d expected = (1.0 - n * chi) * mesh.positions[static_cast<size_t>(v)];
+      for (const int j : r) {
+        expected += chi * mesh.positions[static_cast<size_t>(j)];
+      }
+      extraordinary += r.size() != 6 ? 1 : 0;
+      EXPECT_LT((s.position(s.vertex_point(v)) - expected).norm(), 1e-12)
+          << "depth " << depth << " vertex " << v << " valence " << r.size();
+    }
+    EXPECT_EQ(extraordinary, 12);
+  }
 }
 
 TEST(LimitSurface, ShallowSmoothIsolationStaysCloseToTheDeepLimit) {
