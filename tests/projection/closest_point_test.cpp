@@ -20,6 +20,7 @@
 #include "elastic/core/error.h"
 #include "elastic/mesh/mesh_io.h"
 #include "support.h"
+#include "surface/surface_test_meshes.h"
 
 namespace elastic {
 namespace {
@@ -615,6 +616,33 @@ TEST(Projector, PawnOptimality) {
     ++checked;
   }
   EXPECT_GT(checked, 150);
+}
+
+TEST(SurfaceProjector, DenseControlMeshesGetACoarserTessellationAndTheSameClosestPoints) {
+  // A wavy 120 x 120 quad grid: 14,400 quads would make 460,800 triangles at resolution 4, above
+  // kProjectorMaxTriangles; a 100 x 100 grid (320,000) keeps 4.
+  PolygonMesh wavy = test::quad_grid(120, 120, {0, 0, 0}, {0.01, 0, 0}, {0, 0.01, 0});
+  for (Eigen::Vector3d& p : wavy.positions) {
+    p.z() = 0.05 * std::sin(9.0 * p.x()) * std::cos(7.0 * p.y());
+  }
+  const LimitSurface dense(wavy);
+  const SurfaceProjector coarse(dense);
+  EXPECT_EQ(coarse.tessellation().resolution, 3);
+  EXPECT_LE(static_cast<long>(coarse.tessellation().triangles.size()), kProjectorMaxTriangles);
+  const LimitSurface small(test::quad_grid(100, 100, {0, 0, 0}, {0.01, 0, 0}, {0, 0.01, 0}));
+  EXPECT_EQ(SurfaceProjector(small).tessellation().resolution, 4);
+  // The answer is the limit surface's closest point whatever the tessellation that seeds it.
+  const SurfaceProjector fine(dense, ProjectionOptions{.tessellation = {.resolution = 4}});
+  EXPECT_EQ(fine.tessellation().resolution, 4);
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(0.1, 1.1), h(-0.08, 0.08);
+  for (int k = 0; k < 200; ++k) {
+    const Eigen::Vector3d q(u(rng), u(rng), h(rng));
+    const ClosestPoint a = coarse.closest(q), b = fine.closest(q);
+    ASSERT_TRUE(a.converged && b.converged);
+    EXPECT_NEAR((a.position - q).norm(), (b.position - q).norm(), 1e-9) << k;
+    EXPECT_LT((a.position - b.position).norm(), 1e-6) << k;
+  }
 }
 
 }  // namespace

@@ -161,11 +161,30 @@ TEST(Tessellation, TargetTriangleCount) {
   EXPECT_EQ(tessellate(mixed, {.target_triangles = 1}).resolution % 2, 0);
 }
 
+TEST(Tessellation, MaxTrianglesLowersTheResolution) {
+  const LimitSurface s(test::cube());  // 6 quads: 12 N^2 triangles
+  EXPECT_EQ(tessellate(s, {.resolution = 8, .max_triangles = 12 * 8 * 8}).resolution, 8);
+  EXPECT_EQ(tessellate(s, {.resolution = 8, .max_triangles = 12 * 8 * 8 - 1}).resolution, 7);
+  const LimitTessellation t = tessellate(s, {.resolution = 8, .max_triangles = 100});
+  EXPECT_EQ(t.resolution, 2);  // 48 triangles; 3 would make 108
+  EXPECT_EQ(t.triangles.size(), 48U);
+  EXPECT_EQ(tessellate(s, {.resolution = 8, .max_triangles = 1}).resolution, 1);  // never below 1
+  // It never raises the resolution, and target_triangles takes precedence.
+  EXPECT_EQ(tessellate(s, {.resolution = 3, .max_triangles = 1000000}).resolution, 3);
+  EXPECT_EQ(tessellate(s, {.resolution = 8, .target_triangles = 10000, .max_triangles = 100})
+                .resolution,
+            29);
+  // Catmull-Clark with n-gons keeps an even resolution.
+  const LimitSurface mixed(test::mixed_solid());
+  EXPECT_EQ(tessellate(mixed, {.resolution = 8, .max_triangles = 1}).resolution, 2);
+}
+
 TEST(Tessellation, RejectsBadOptions) {
   const LimitSurface s(test::cube(), {.name = "cube"});
   EXPECT_THROW(tessellate(s, {.resolution = 0}), InvalidInputError);
   EXPECT_THROW(tessellate(s, {.resolution = 1025}), InvalidInputError);
   EXPECT_THROW(tessellate(s, {.resolution = 8, .target_triangles = -5}), InvalidInputError);
+  EXPECT_THROW(tessellate(s, {.resolution = 8, .max_triangles = -5}), InvalidInputError);
 }
 
 }  // namespace

@@ -61,16 +61,17 @@ int tessellation_resolution(const LimitSurface& surface, const TessellationOptio
   }
   const bool need_even = !loop && subfaces > 0;
   int n = options.resolution;
-  if (options.target_triangles < 0) {
+  if (options.target_triangles < 0 || options.max_triangles < 0) {
     throw InvalidInputError(surface.name(), "tessellation target_triangles " +
                                                 std::to_string(options.target_triangles) +
+                                                " or max_triangles " +
+                                                std::to_string(options.max_triangles) +
                                                 " is negative");
   }
+  // Triangles per N^2: 1 per Loop triangle, 2 per quad, 1/2 per n-gon sub-face (N/2 segments).
+  const double per_n2 = loop ? static_cast<double>(quads)
+                             : 2.0 * static_cast<double>(quads) + 0.5 * static_cast<double>(subfaces);
   if (options.target_triangles > 0) {
-    // Triangles per N^2: 1 per Loop triangle, 2 per quad, 1/2 per n-gon sub-face (N/2 segments).
-    const double per_n2 =
-        loop ? static_cast<double>(quads)
-             : 2.0 * static_cast<double>(quads) + 0.5 * static_cast<double>(subfaces);
     const double exact = std::sqrt(static_cast<double>(options.target_triangles) / per_n2);
     // Nearest admissible resolution (even when needed, so that sub-faces get N/2 segments).
     const long step = need_even ? 2 : 1;
@@ -82,6 +83,13 @@ int tessellation_resolution(const LimitSurface& surface, const TessellationOptio
   }
   if (need_even && n % 2 == 1) {
     n = std::min(n + 1, 1024);
+  }
+  if (options.target_triangles == 0 && options.max_triangles > 0) {
+    const int step = need_even ? 2 : 1;
+    while (n > step && per_n2 * static_cast<double>(n) * static_cast<double>(n) >
+                           static_cast<double>(options.max_triangles)) {
+      n -= step;
+    }
   }
   return n;
 }
