@@ -30,22 +30,30 @@ Topology topology(int num_vertices, const std::vector<std::vector<int>>& polygon
   t.faces = static_cast<long>(polygons.size());
   std::map<std::pair<int, int>, int> directed;
   for (const auto& poly : polygons) {
-    for (size_t i = 0; i < poly.size(); ++i) ++directed[{poly[i], poly[(i + 1) % poly.size()]}];
+    for (size_t i = 0; i < poly.size(); ++i) {
+      ++directed[{poly[i], poly[(i + 1) % poly.size()]}];
+    }
   }
   std::map<int, int> boundary_next;
   std::set<std::pair<int, int>> undirected;
   for (const auto& [e, count] : directed) {
     undirected.insert({std::min(e.first, e.second), std::max(e.first, e.second)});
-    if (count != 1) t.manifold_and_oriented = false;
+    if (count != 1) {
+      t.manifold_and_oriented = false;
+    }
     if (!directed.count({e.second, e.first})) {
-      if (boundary_next.count(e.first)) t.manifold_and_oriented = false;
+      if (boundary_next.count(e.first)) {
+        t.manifold_and_oriented = false;
+      }
       boundary_next[e.first] = e.second;
     }
   }
   t.edges = static_cast<long>(undirected.size());
   std::set<int> seen;
   for (const auto& [start, next] : boundary_next) {
-    if (seen.count(start)) continue;
+    if (seen.count(start)) {
+      continue;
+    }
     ++t.boundary_loops;
     for (int v = start; !seen.count(v); v = boundary_next.count(v) ? boundary_next[v] : start) {
       seen.insert(v);
@@ -56,14 +64,18 @@ Topology topology(int num_vertices, const std::vector<std::vector<int>>& polygon
 
 Topology topology(const PolygonMesh& mesh) {
   std::vector<std::vector<int>> polys;
-  for (int f = 0; f < mesh.num_faces(); ++f)
+  polys.reserve(static_cast<size_t>(mesh.num_faces()));
+  for (int f = 0; f < mesh.num_faces(); ++f) {
     polys.emplace_back(mesh.face(f).begin(), mesh.face(f).end());
+  }
   return topology(mesh.num_vertices(), polys);
 }
 
 Topology topology(const LimitTessellation& t) {
   std::vector<std::vector<int>> polys;
-  for (const auto& tri : t.triangles) polys.push_back({tri[0], tri[1], tri[2]});
+  for (const auto& tri : t.triangles) {
+    polys.push_back({tri[0], tri[1], tri[2]});
+  }
   return topology(static_cast<int>(t.positions.size()), polys);
 }
 
@@ -83,7 +95,9 @@ void expect_matches_control_topology(const LimitSurface& s, const LimitTessellat
   // Triangles wind like the control mesh: each triangle's normal agrees with the limit surface
   // normals at its corners (the tessellations here are fine enough for that to be unambiguous).
   std::vector<Eigen::Vector3d> normals(t.points.size());
-  for (size_t i = 0; i < t.points.size(); ++i) normals[i] = s.curvature(t.points[i]).normal;
+  for (size_t i = 0; i < t.points.size(); ++i) {
+    normals[i] = s.curvature(t.points[i]).normal;
+  }
   for (const auto& tri : t.triangles) {
     const Eigen::Vector3d& a = t.positions[static_cast<size_t>(tri[0])];
     const Eigen::Vector3d n = (t.positions[static_cast<size_t>(tri[1])] - a)
@@ -145,7 +159,9 @@ TEST(Tessellation, SharedVerticesAreWeldedNotDuplicated) {
   std::sort(sorted.begin(), sorted.end(), [](const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
     return std::lexicographical_compare(a.data(), a.data() + 3, b.data(), b.data() + 3);
   });
-  for (size_t i = 1; i < sorted.size(); ++i) EXPECT_GT((sorted[i] - sorted[i - 1]).norm(), 1e-9);
+  for (size_t i = 1; i < sorted.size(); ++i) {
+    EXPECT_GT((sorted[i] - sorted[i - 1]).norm(), 1e-9);
+  }
 }
 
 TEST(Tessellation, TargetTriangleCount) {
@@ -163,17 +179,17 @@ TEST(Tessellation, TargetTriangleCount) {
 
 TEST(Tessellation, MaxTrianglesLowersTheResolution) {
   const LimitSurface s(test::cube());  // 6 quads: 12 N^2 triangles
-  EXPECT_EQ(tessellate(s, {.resolution = 8, .max_triangles = 12 * 8 * 8}).resolution, 8);
-  EXPECT_EQ(tessellate(s, {.resolution = 8, .max_triangles = 12 * 8 * 8 - 1}).resolution, 7);
+  EXPECT_EQ(tessellate(s, {.resolution = 8, .max_triangles = 12L * 8 * 8}).resolution, 8);
+  EXPECT_EQ(tessellate(s, {.resolution = 8, .max_triangles = (12L * 8 * 8) - 1}).resolution, 7);
   const LimitTessellation t = tessellate(s, {.resolution = 8, .max_triangles = 100});
   EXPECT_EQ(t.resolution, 2);  // 48 triangles; 3 would make 108
   EXPECT_EQ(t.triangles.size(), 48U);
   EXPECT_EQ(tessellate(s, {.resolution = 8, .max_triangles = 1}).resolution, 1);  // never below 1
   // It never raises the resolution, and target_triangles takes precedence.
   EXPECT_EQ(tessellate(s, {.resolution = 3, .max_triangles = 1000000}).resolution, 3);
-  EXPECT_EQ(tessellate(s, {.resolution = 8, .target_triangles = 10000, .max_triangles = 100})
-                .resolution,
-            29);
+  EXPECT_EQ(
+      tessellate(s, {.resolution = 8, .target_triangles = 10000, .max_triangles = 100}).resolution,
+      29);
   // Catmull-Clark with n-gons keeps an even resolution.
   const LimitSurface mixed(test::mixed_solid());
   EXPECT_EQ(tessellate(mixed, {.resolution = 8, .max_triangles = 1}).resolution, 2);

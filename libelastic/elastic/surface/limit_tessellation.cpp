@@ -62,15 +62,15 @@ int tessellation_resolution(const LimitSurface& surface, const TessellationOptio
   const bool need_even = !loop && subfaces > 0;
   int n = options.resolution;
   if (options.target_triangles < 0 || options.max_triangles < 0) {
-    throw InvalidInputError(surface.name(), "tessellation target_triangles " +
-                                                std::to_string(options.target_triangles) +
-                                                " or max_triangles " +
-                                                std::to_string(options.max_triangles) +
-                                                " is negative");
+    throw InvalidInputError(surface.name(),
+                            "tessellation target_triangles " +
+                                std::to_string(options.target_triangles) + " or max_triangles " +
+                                std::to_string(options.max_triangles) + " is negative");
   }
   // Triangles per N^2: 1 per Loop triangle, 2 per quad, 1/2 per n-gon sub-face (N/2 segments).
-  const double per_n2 = loop ? static_cast<double>(quads)
-                             : 2.0 * static_cast<double>(quads) + 0.5 * static_cast<double>(subfaces);
+  const double per_n2 =
+      loop ? static_cast<double>(quads)
+           : 2.0 * static_cast<double>(quads) + 0.5 * static_cast<double>(subfaces);
   if (options.target_triangles > 0) {
     const double exact = std::sqrt(static_cast<double>(options.target_triangles) / per_n2);
     // Nearest admissible resolution (even when needed, so that sub-faces get N/2 segments).
@@ -222,21 +222,39 @@ class Tessellator {
   int* quad_slot(int f, int k, int sub, int i, int j, int m) {
     if (k == 4) {
       // Quad: edges 0..3 are control edges 0..3 at parameters u, v, 1-u, 1-v.
-      if (j == 0) return edge_slot(f, 0, i);
-      if (i == m) return edge_slot(f, 1, j);
-      if (j == m) return edge_slot(f, 2, m - i);
-      if (i == 0) return edge_slot(f, 3, m - j);
+      if (j == 0) {
+        return edge_slot(f, 0, i);
+      }
+      if (i == m) {
+        return edge_slot(f, 1, j);
+      }
+      if (j == m) {
+        return edge_slot(f, 2, m - i);
+      }
+      if (i == 0) {
+        return edge_slot(f, 3, m - j);
+      }
       return nullptr;
     }
     // Sub-face `sub`: (0,0) corner vertex, edge 0 = first half of control edge `sub`, edge 3 =
     // second half of control edge sub-1, edge 1 = spoke `sub` (midpoint -> centre), edge 2 = spoke
     // sub-1 (centre <- midpoint), (1,1) = face centre.
     const int prev = (sub + k - 1) % k;
-    if (i == m && j == m) return &centre_ids_[static_cast<size_t>(f)];
-    if (j == 0) return edge_slot(f, sub, i);
-    if (i == 0) return edge_slot(f, prev, n_ - j);
-    if (i == m) return spoke_slot(f, sub, j);
-    if (j == m) return spoke_slot(f, prev, i);
+    if (i == m && j == m) {
+      return &centre_ids_[static_cast<size_t>(f)];
+    }
+    if (j == 0) {
+      return edge_slot(f, sub, i);
+    }
+    if (i == 0) {
+      return edge_slot(f, prev, n_ - j);
+    }
+    if (i == m) {
+      return spoke_slot(f, sub, j);
+    }
+    if (j == m) {
+      return spoke_slot(f, prev, i);
+    }
     return nullptr;
   }
 

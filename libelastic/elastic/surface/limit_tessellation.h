@@ -28,7 +28,8 @@ struct TessellationOptions {
   long target_triangles = 0;
   /// When > 0 and `target_triangles` is 0: `resolution` is lowered (to no less than 1, or 2 where
   /// it must be even) while the tessellation would have more triangles than this. A dense control
-  /// mesh, such as a scan, is already finer than what a coarser tessellation of it needs to resolve.
+  /// mesh, such as a scan, is already finer than what a coarser tessellation of it needs to
+  /// resolve.
   long max_triangles = 0;
 };
 
