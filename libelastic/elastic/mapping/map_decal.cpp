@@ -294,19 +294,20 @@ double snap_into_region(const RegionDiskMap& disk, const Region& region, double 
       continue;
     }
     const Eigen::Vector3d x = relaxed.positions.col(static_cast<Eigen::Index>(p));
+    // One pass over the boundary loop: its nearest vertex (the snap) and the distance to its
+    // chords (the test; a chord's ends are among the vertices, so outside <= nearest).
     int best = -1;
     double nearest = std::numeric_limits<double>::infinity();
-    for (const int v : region.boundary) {
-      const double d = (region.positions[static_cast<size_t>(v)] - x).norm();
+    double outside = nearest;
+    const size_t nb = region.boundary.size();
+    for (size_t i = 0; i < nb; ++i) {
+      const int v = region.boundary[i];
+      const Eigen::Vector3d a = region.positions[static_cast<size_t>(v)];
+      const double d = (a - x).norm();
       if (d < nearest) {
         nearest = d;
         best = v;
       }
-    }
-    double outside = nearest;  // distance to the boundary curve's chords
-    const size_t nb = region.boundary.size();
-    for (size_t i = 0; i < nb; ++i) {
-      const Eigen::Vector3d a = region.positions[static_cast<size_t>(region.boundary[i])];
       const Eigen::Vector3d ab =
           region.positions[static_cast<size_t>(region.boundary[(i + 1) % nb])] - a;
       const double t =
