@@ -243,6 +243,36 @@ TEST(BoundaryRegion, CapIsTheWholeCapCounterClockwiseAboutItsNormal) {
   EXPECT_GT(projected_winding_area(region, Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitZ()), 0.0);
 }
 
+TEST(BoundaryChords, EachChordFindsTheTriangleWithThatEdgeForwardThenReversed) {
+  // A square of two counter-clockwise triangles, (0 1 2) and (0 2 3).
+  Region square;
+  square.positions = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}};
+  square.triangles = {{0, 1, 2}, {0, 2, 3}};
+  auto expect_chord = [](const BoundaryChord& c, int triangle, int from, int to) {
+    EXPECT_EQ(c.triangle, triangle);
+    EXPECT_EQ(c.corner_from, from);
+    EXPECT_EQ(c.corner_to, to);
+  };
+  square.boundary = {0, 1, 2, 3};  // counter-clockwise: every chord is a triangle's own edge
+  std::vector<BoundaryChord> chords = square.boundary_chords();
+  ASSERT_EQ(chords.size(), 4U);
+  expect_chord(chords[0], 0, 0, 1);
+  expect_chord(chords[1], 0, 1, 2);
+  expect_chord(chords[2], 1, 1, 2);
+  expect_chord(chords[3], 1, 2, 0);
+  square.boundary = {0, 3, 2, 1};  // clockwise: the reversed edges, corners still from -> to
+  chords = square.boundary_chords();
+  expect_chord(chords[0], 1, 0, 2);
+  expect_chord(chords[1], 1, 2, 1);
+  expect_chord(chords[2], 0, 2, 1);
+  expect_chord(chords[3], 0, 1, 0);
+  square.boundary = {0, 1, 3};  // 1 -> 3 is no triangle's edge
+  chords = square.boundary_chords();
+  expect_chord(chords[0], 0, 0, 1);
+  EXPECT_EQ(chords[1].triangle, -1);
+  expect_chord(chords[2], 1, 2, 0);
+}
+
 TEST(PointsRegion, SquareOnPlaneInEitherOrderGivesTheSameOrientedSquare) {
   const Fixture fx(plane_mesh());
   const double a = 0.4;

@@ -7,7 +7,6 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <map>
 #include <numbers>
 #include <numeric>
 #include <optional>
@@ -92,13 +91,7 @@ RegionDiskMap::RegionDiskMap(const Region& region) : region_(&region) {
 
   // Boundary: arc lengths and, for each boundary edge, the triangle that holds it.
   const int n = static_cast<int>(region.boundary.size());
-  std::map<std::pair<int, int>, std::pair<int, Eigen::Vector2i>> edge_triangle;
-  for (int t = 0; t < region.num_triangles(); ++t) {
-    for (int k = 0; k < 3; ++k) {
-      edge_triangle[{region.triangles[t][k], region.triangles[t][(k + 1) % 3]}] = {
-          t, Eigen::Vector2i(k, (k + 1) % 3)};
-    }
-  }
+  const std::vector<BoundaryChord> chords = region.boundary_chords();
   locators->boundary_arc.resize(n + 1, 0.0);
   locators->boundary_triangle.resize(n);
   locators->boundary_corners.resize(n);
@@ -108,12 +101,12 @@ RegionDiskMap::RegionDiskMap(const Region& region) : region_(&region) {
         locators->boundary_arc[k] + (region.positions[b] - region.positions[a]).norm();
     // The boundary runs counter-clockwise, like the triangles, so edge a->b is a triangle's own
     // edge.
-    auto it = edge_triangle.find({a, b});
-    if (it == edge_triangle.end()) {
+    const BoundaryChord& chord = chords[k];
+    if (chord.triangle < 0 || chord.corner_to != (chord.corner_from + 1) % 3) {
       throw InvalidInputError("region", "boundary edge is not an edge of a region triangle");
     }
-    locators->boundary_triangle[k] = it->second.first;
-    locators->boundary_corners[k] = it->second.second;
+    locators->boundary_triangle[k] = chord.triangle;
+    locators->boundary_corners[k] = Eigen::Vector2i(chord.corner_from, chord.corner_to);
   }
   const double total = locators->boundary_arc[n];
   if (!(total > 0.0)) {

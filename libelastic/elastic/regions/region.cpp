@@ -1,6 +1,8 @@
 #include "elastic/regions/region.h"
 
 #include <Eigen/Geometry>
+#include <cstdint>
+#include <unordered_map>
 
 namespace elastic {
 
@@ -14,6 +16,44 @@ SurfaceCurve Region::boundary_curve() const {
   }
   curve.anchor = anchor;
   return curve;
+}
+
+std::vector<BoundaryChord> Region::boundary_chords() const {
+  const size_t n = boundary.size();
+  std::vector<BoundaryChord> chords(n);
+  if (n < 2) {
+    return chords;
+  }
+  auto key = [](int a, int b) {
+    return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(a)) << 32U) |
+           static_cast<std::uint32_t>(b);
+  };
+  // chord key -> k; a chord repeated in the loop (not a simple curve) keeps its first k, and the
+  // others are copied from it below.
+  std::unordered_map<std::uint64_t, size_t> chord_index;
+  chord_index.reserve(n);
+  for (size_t k = 0; k < n; ++k) {
+    chord_index.try_emplace(key(boundary[k], boundary[(k + 1) % n]), k);
+  }
+  std::vector<BoundaryChord> reversed(n);
+  for (int t = 0; t < num_triangles(); ++t) {
+    const Eigen::Vector3i& tri = triangles[static_cast<size_t>(t)];
+    for (int c = 0; c < 3; ++c) {
+      const int d = (c + 1) % 3;
+      if (auto it = chord_index.find(key(tri[c], tri[d])); it != chord_index.end()) {
+        chords[it->second] = {t, c, d};
+      }
+      if (auto it = chord_index.find(key(tri[d], tri[c]));
+          it != chord_index.end() && reversed[it->second].triangle < 0) {
+        reversed[it->second] = {t, d, c};
+      }
+    }
+  }
+  for (size_t k = 0; k < n; ++k) {
+    const size_t first = chord_index.at(key(boundary[k], boundary[(k + 1) % n]));
+    chords[k] = chords[first].triangle >= 0 ? chords[first] : reversed[first];
+  }
+  return chords;
 }
 
 double Region::area() const {

@@ -22,6 +22,13 @@
 
 namespace elastic {
 
+/// The region triangle that holds one boundary chord boundary[k] -> boundary[k + 1].
+struct BoundaryChord {
+  int triangle = -1;    ///< region triangle, -1 when no triangle has the chord as an edge
+  int corner_from = 0;  ///< corner (0..2) of `triangle` at boundary[k]
+  int corner_to = 0;    ///< corner (0..2) of `triangle` at boundary[k + 1]
+};
+
 struct Region {
   const LimitSurface* surface = nullptr;  ///< the surface the region lies on (not owned)
 
@@ -43,6 +50,10 @@ struct Region {
   int num_triangles() const { return static_cast<int>(triangles.size()); }
   /// The boundary as a SurfaceCurve (with `anchor`).
   SurfaceCurve boundary_curve() const;
+  /// For each boundary chord k (boundary[k] -> boundary[k + 1], cyclic), the triangle holding it
+  /// as its own counter-clockwise edge (the last such triangle), or else one holding it reversed
+  /// (the first); `triangle` is -1 when neither exists. O(#T) with only the chords keyed.
+  std::vector<BoundaryChord> boundary_chords() const;
   /// Sum of triangle areas.
   double area() const;
   /// The SurfacePoint at barycentric coordinates (b1, b2) of triangle t (b0 = 1 - b1 - b2).

@@ -3,7 +3,6 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <limits>
-#include <map>
 #include <string>
 #include <vector>
 
@@ -106,13 +105,7 @@ struct TessellationIndex {
 void embed_boundary(CutMesh& cut, const Region& region, const TessellationIndex& index, double snap,
                     const std::string& name) {
   const int n = static_cast<int>(region.boundary.size());
-  std::map<std::pair<int, int>, int> directed;
-  for (int t = 0; t < region.num_triangles(); ++t) {
-    const Eigen::Vector3i& tri = region.triangles[static_cast<size_t>(t)];
-    for (int k = 0; k < 3; ++k) {
-      directed[{tri[k], tri[(k + 1) % 3]}] = t;
-    }
-  }
+  const std::vector<BoundaryChord> chords = region.boundary_chords();
   struct Node {
     int vertex;
     int face;
@@ -121,12 +114,11 @@ void embed_boundary(CutMesh& cut, const Region& region, const TessellationIndex&
   std::vector<Node> nodes;
   for (int k = 0; k < n; ++k) {
     const int a = region.boundary[static_cast<size_t>(k)];
-    const int b = region.boundary[static_cast<size_t>((k + 1) % n)];
-    const auto it = directed.find({a, b});
-    if (it == directed.end()) {
+    const BoundaryChord& chord = chords[static_cast<size_t>(k)];
+    if (chord.triangle < 0 || chord.corner_to != (chord.corner_from + 1) % 3) {
       throw InvalidInputError(name, "the region's boundary is not a loop of its triangles' edges");
     }
-    const int t = it->second;
+    const int t = chord.triangle;
     const int face = region.triangle_face[static_cast<size_t>(t)];
     const Eigen::Vector2d uv = corner_uv_of(region, t, a);
     const int origin = index.locate(face, uv);

@@ -1,7 +1,6 @@
 #include "elastic/sampling/boundary_sampler.h"
 
 #include <cmath>
-#include <map>
 #include <string>
 #include <utility>
 
@@ -16,24 +15,16 @@ BoundarySampler::BoundarySampler(const Region& region, const std::string& name)
   if (!(length_ > 0.0) || !std::isfinite(length_)) {
     throw InvalidInputError(name, "the boundary curve has zero length");
   }
-  // Directed edge (a, b) -> (triangle, corner of a, corner of b).
-  std::map<std::pair<int, int>, Eigen::Vector3i> edge_owner;
-  for (int t = 0; t < region.num_triangles(); ++t) {
-    const Eigen::Vector3i& tri = region.triangles[t];
-    for (int c = 0; c < 3; ++c) {
-      edge_owner[{tri[c], tri[(c + 1) % 3]}] = Eigen::Vector3i(t, c, (c + 1) % 3);
-      edge_owner.try_emplace({tri[(c + 1) % 3], tri[c]}, t, (c + 1) % 3, c);
-    }
-  }
+  const std::vector<BoundaryChord> chords = region.boundary_chords();
   const int n = static_cast<int>(region.boundary.size());
   chord_triangle_.resize(n);
   for (int k = 0; k < n; ++k) {
-    const auto it = edge_owner.find({region.boundary[k], region.boundary[(k + 1) % n]});
-    if (it == edge_owner.end()) {
+    const BoundaryChord& chord = chords[k];
+    if (chord.triangle < 0) {
       throw InvalidInputError(name, "boundary chord " + std::to_string(k) +
                                         " is not an edge of the region's triangles");
     }
-    chord_triangle_[k] = it->second;
+    chord_triangle_[k] = Eigen::Vector3i(chord.triangle, chord.corner_from, chord.corner_to);
   }
 }
 
