@@ -432,7 +432,10 @@ struct Multigrid::Impl {
     for (std::size_t l = 0; l < levels.size(); ++l) {
       const auto size = 3 * static_cast<std::size_t>(levels[l].a.rows);
       for (auto* v : {&w[l].b, &w[l].x, &w[l].r, &w[l].d, &w[l].t}) {
-        assign_huge(*v, size, 0.0);
+        // Level 0's b and x are the caller's, except for the second and later cycles (apply).
+        if (l > 0 || options.cycles > 1 || (v != &w[l].b && v != &w[l].x)) {
+          assign_huge(*v, size, 0.0);
+        }
       }
     }
     return w;

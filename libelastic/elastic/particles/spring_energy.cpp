@@ -237,7 +237,7 @@ void SpringSystem::build_barrier(const ParticleGrid& grid) {
     pairs.emplace_back(barrier_[t].prev, code + 2);
   }
   build_incidence(num_particles_, pairs, barrier_offset_, barrier_entry_);
-  barrier_force_.resize(3, 3 * static_cast<Eigen::Index>(barrier_.size()));
+  barrier_force_.resize(3, 2 * static_cast<Eigen::Index>(barrier_.size()));
   barrier_normal_force_.resize(3, static_cast<Eigen::Index>(barrier_.size()));
 }
 
@@ -374,9 +374,9 @@ Eigen::Vector2d SpringSystem::triangle_energy(const Eigen::Matrix3Xd& x,
       [&](const tbb::blocked_range<std::size_t>& range, Eigen::Vector2d sum) {
         for (std::size_t t = range.begin(); t != range.end(); ++t) {
           const BarrierTriangle& b = barrier_[t];
-          const auto col = 3 * static_cast<Eigen::Index>(t);
+          const auto col = 2 * static_cast<Eigen::Index>(t);
           if (want_gradient) {
-            barrier_force_.middleCols<3>(col).setZero();
+            barrier_force_.middleCols<2>(col).setZero();
             barrier_normal_force_.col(static_cast<Eigen::Index>(t)).setZero();
           }
           if (!barrier_active_[t]) {
@@ -445,9 +445,8 @@ Eigen::Vector2d SpringSystem::triangle_energy(const Eigen::Matrix3Xd& x,
             f1 += sd_da * da1 + sd_dd * dd1;
             de_dd += sd_dd;
           }
-          barrier_force_.col(col) = -(f0 + f1);
-          barrier_force_.col(col + 1) = f0;
-          barrier_force_.col(col + 2) = f1;
+          barrier_force_.col(col) = f0;  // corner i's, -(f0 + f1), is formed where it is gathered
+          barrier_force_.col(col + 1) = f1;
           if (normals != nullptr) {
             // dE/dn_j for each corner j: with s = n_i + n_next + n_prev, u = s / |s| and
             // D = (c . u)^2, dD/dn_j = dD/ds = 2 (c . u) (I - u u^T) c / |s|.
@@ -486,7 +485,13 @@ void SpringSystem::gather_gradient(bool with_barrier, Eigen::Matrix3Xd& gradient
                         }
                         if (with_barrier) {
                           for (int k = barrier_offset_[p]; k < barrier_offset_[p + 1]; ++k) {
-                            g += barrier_force_.col(barrier_entry_[k]);
+                            const int code = barrier_entry_[k], role = code % 3;
+                            const auto col = 2 * static_cast<Eigen::Index>(code / 3);
+                            if (role == 0) {
+                              g += -(barrier_force_.col(col) + barrier_force_.col(col + 1));
+                            } else {
+                              g += barrier_force_.col(col + role - 1);
+                            }
                           }
                         }
                         gradient.col(p) = g;

@@ -245,8 +245,10 @@ class SpringSystem {
   std::vector<BarrierTriangle> barrier_;
   std::vector<char> barrier_active_;
   std::vector<int> barrier_offset_,
-      barrier_entry_;                              // code 3 * triangle + role (0 i, 1 next, 2 prev)
-  mutable Eigen::Matrix3Xd barrier_force_;         // 3 columns per triangle: dE/dx of i, next, prev
+      barrier_entry_;  // code 3 * triangle + role (0 i, 1 next, 2 prev)
+  // 2 columns per triangle: dE/dx of next and prev (that of i is minus their sum: a third less
+  // memory, 96 MB at a million particles).
+  mutable Eigen::Matrix3Xd barrier_force_;
   mutable Eigen::Matrix3Xd barrier_normal_force_;  // per triangle: dE/dn_i (with normals)
   mutable Eigen::Matrix3Xd spring_force_;          // per spring: dE/dx_j
   mutable Eigen::Matrix3Xd angular_force_;         // per angular spring: dE/dx_i
