@@ -5,10 +5,12 @@
 #include "elastic/metrics/map_metrics.h"
 
 #include <gtest/gtest.h>
+#include <tbb/task_arena.h>
 
 #include <Eigen/Geometry>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <utility>
 
@@ -204,21 +206,27 @@ int brute_force_folds(const ParticleGrid& grid, const Eigen::Matrix3Xd& y, doubl
   int count = 0;
   for (const auto fh : grid.mesh.faces()) {
     std::vector<int> c;
-    for (const auto vh : grid.mesh.fv_range(fh)) c.push_back(vh.idx());
+    for (const auto vh : grid.mesh.fv_range(fh)) {
+      c.push_back(vh.idx());
+    }
     const int n = static_cast<int>(c.size());
     bool folded = false;
     for (int omit = 0; omit < (n == 3 ? 1 : n); ++omit) {
       std::array<int, 3> t{};
       int m = 0;
       for (int k = 0; k < n && m < 3; ++k) {
-        if (n == 3 || k != omit) t[m++] = c[k];
+        if (n == 3 || k != omit) {
+          t[m++] = c[k];
+        }
       }
       const Eigen::Vector3d a = y.col(t[0]), b = y.col(t[1]), d = y.col(t[2]);
       const double z = (b.x() - a.x()) * (d.y() - a.y()) - (b.y() - a.y()) * (d.x() - a.x());
       folded = folded || up * z <= 0.0;
     }
     count += folded ? 1 : 0;
-    if (per_face != nullptr) per_face->push_back(folded ? 1 : 0);
+    if (per_face != nullptr) {
+      per_face->push_back(folded ? 1 : 0);
+    }
   }
   return count;
 }
@@ -334,7 +342,9 @@ TEST(MapMetrics, SigmaMinOfAnAffineMapIsItsSmallerSingularValueOverSigma) {
   const MapMetrics m = measure_map(grid, y, options);
   EXPECT_EQ(m.folds, 0);
   EXPECT_NEAR(m.sigma_min, b / sigma, kTight);
-  for (const double v : m.per_face.sigma_min) EXPECT_NEAR(v, b / sigma, kTight);
+  for (const double v : m.per_face.sigma_min) {
+    EXPECT_NEAR(v, b / sigma, kTight);
+  }
   // A mirror image (diag(a, -b)) inverts every triangle: sigma_min = -b / sigma, every face folded.
   const Eigen::Matrix3Xd mirrored =
       transformed(grid.source_positions(), r * Eigen::Vector3d(a, -b, 1.0).asDiagonal(),
@@ -376,8 +386,12 @@ TEST(MapMetrics, OutsideParticlesAreExcludedAndCounted) {
   options.target_normals = constant_normals(n, Eigen::Vector3d::UnitZ());
   const MapMetrics m = measure_map(grid, y, options);
   int touching = 0, springs = 0;
-  for (const auto& tri : m.triangles) touching += (tri.array() == 6).any() ? 1 : 0;
-  for (const auto& s : grid.springs) springs += (s.i == 6 || s.j == 6) ? 1 : 0;
+  for (const auto& tri : m.triangles) {
+    touching += (tri.array() == 6).any() ? 1 : 0;
+  }
+  for (const auto& s : grid.springs) {
+    springs += (s.i == 6 || s.j == 6) ? 1 : 0;
+  }
   EXPECT_EQ(m.outside, 1);
   EXPECT_EQ(m.outside_triangles, touching);
   EXPECT_EQ(m.measured_triangles, static_cast<int>(m.triangles.size()) - touching);
@@ -393,6 +407,56 @@ TEST(MapMetrics, TrianglesAreTheFirstCornerFan) {
   ASSERT_EQ(tris.size(), 8u);
   EXPECT_EQ(tris[4], Eigen::Vector3i(3, 4, 7));
   EXPECT_EQ(tris[5], Eigen::Vector3i(3, 7, 6));
+}
+
+TEST(MapMetrics, ParallelSumsMatchTheTrianglesAndDoNotDependOnTheThreadCount) {
+  // 90 x 60 squares: about 10,700 triangles, several of the reductions' chunks, on a curved
+  // source under a smooth non-affine map with one face folded by hand.
+  const ParticleGrid grid = make_grid(90, 60, 0.4);
+  Eigen::Matrix3Xd y = grid.source_positions();
+  for (int p = 0; p < y.cols(); ++p) {
+    const Eigen::Vector3d x = y.col(p);
+    y.col(p) = Eigen::Vector3d(x.x() + 0.1 * std::sin(x.y()), 1.1 * x.y(), x.z() + 0.05 * x.x());
+  }
+  const int middle = 30 * 91 + 45;  // a vertex inside: moved across its neighbour
+  y.col(middle) = y.col(middle + 2);
+  MapMetricsOptions options;
+  options.target_normals = constant_normals(grid.num_particles(), Eigen::Vector3d::UnitZ());
+  MapMetrics one, many;
+  tbb::task_arena(1).execute([&] { one = measure_map(grid, y, options); });
+  tbb::task_arena(4).execute([&] { many = measure_map(grid, y, options); });
+  for (const auto& [a, b] : {std::pair{one.stretch_l2, many.stretch_l2},
+                             std::pair{one.area_distortion, many.area_distortion},
+                             std::pair{one.symmetric_dirichlet, many.symmetric_dirichlet},
+                             std::pair{one.angle_error_mean_deg, many.angle_error_mean_deg},
+                             std::pair{one.angle_error_max_deg, many.angle_error_max_deg},
+                             std::pair{one.sigma_min, many.sigma_min}}) {
+    EXPECT_EQ(a, b);
+  }
+  EXPECT_EQ(one.folds, many.folds);
+  EXPECT_GT(one.folds, 0);
+  // The aggregates against sums taken here, triangle by triangle, from the per-triangle values.
+  const TriangleValues& tv = one.per_triangle;
+  double area = 0.0, regular = 0.0, sd = 0.0, worst_angle = 0.0;
+  int measured = 0;
+  for (std::size_t t = 0; t < tv.s1.size(); ++t) {
+    ++measured;
+    area += tv.source_area[t];
+    worst_angle = std::max(worst_angle, tv.angle_error_deg[t]);
+    if (std::isfinite(tv.symmetric_dirichlet[t])) {
+      regular += tv.source_area[t];
+      sd += tv.source_area[t] * tv.symmetric_dirichlet[t];
+    }
+  }
+  EXPECT_EQ(one.measured_triangles, measured);
+  EXPECT_EQ(one.angle_error_max_deg, worst_angle);
+  EXPECT_NEAR(one.symmetric_dirichlet, sd / regular, 1e-12 * (sd / regular));
+  double worst_sigma = std::numeric_limits<double>::infinity();
+  for (const double v : one.per_face.sigma_min) {
+    worst_sigma = std::min(worst_sigma, v);
+  }
+  EXPECT_EQ(one.sigma_min, worst_sigma);
+  EXPECT_LT(one.sigma_min, 0.0);  // the folded face's, negative
 }
 
 TEST(MapMetrics, RejectsInconsistentInput) {

@@ -1,5 +1,9 @@
 #include "elastic/metrics/map_metrics.h"
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
+
 #include <Eigen/Dense>
 #include <algorithm>
 #include <array>
@@ -155,6 +159,10 @@ const std::vector<double>& TriangleValues::values(TriangleMetric metric) const {
 
 namespace {
 
+// Faces or triangles per task of the parallel loops below: fixed, so that the deterministic
+// reductions split the same way on any number of threads.
+constexpr int kGrain = 4096;
+
 // The inputs' sizes and values; returns the particles left out (the outside mask).
 std::vector<char> check_measure_inputs(const ParticleGrid& grid,
                                        const Eigen::Matrix3Xd& target_positions,
@@ -234,55 +242,74 @@ int judge_faces(const ParticleGrid& grid, const Eigen::Matrix3Xd& source,
   const double nan = std::numeric_limits<double>::quiet_NaN();
   const double inf = std::numeric_limits<double>::infinity();
   FaceValues& fv = out.per_face;
-  int folds = 0;
-  double worst_sigma = inf;
-  int judged_faces = 0;
-  std::vector<int> corners;
-  for (const auto fh : grid.mesh.faces()) {
-    const int f = fh.idx();
-    corners.clear();
-    for (const auto vh : grid.mesh.fv_range(fh)) {
-      corners.push_back(vh.idx());
-    }
-    bool excluded = false;
-    for (const int c : corners) {
-      excluded = excluded || skip[c] != 0;
-    }
-    if (excluded) {
-      fv.excluded[f] = 1;
-      continue;
-    }
-    bool folded = false, degenerate = false;
-    double sigma_min = inf;
-    for (const Eigen::Vector3i& local : face_triangulations(static_cast<int>(corners.size()))) {
-      const int a = corners[local[0]], b = corners[local[1]], c = corners[local[2]];
-      TrianglePair pair;
-      if (!analyse_pair(source.col(a), source.col(b), source.col(c), target_positions.col(a),
-                        target_positions.col(b), target_positions.col(c), sigma, pair)) {
-        throw InvalidInputError(
-            name, "grid face " + std::to_string(f) + " has a zero-area triangle on the source");
+  // Faces are judged independently (each writes its own entries); the counts and the minimum
+  // are exact in any order, so the result does not depend on the thread count.
+  struct Judged {
+    int folds = 0, degenerate = 0, judged = 0;
+    double worst_sigma = std::numeric_limits<double>::infinity();
+  };
+  const auto judge = [&](const tbb::blocked_range<int>& range, Judged sum) {
+    std::vector<int> corners;
+    for (int f = range.begin(); f != range.end(); ++f) {
+      corners.clear();
+      for (const auto vh : grid.mesh.fv_range(GridMesh::FaceHandle(f))) {
+        corners.push_back(vh.idx());
       }
-      const bool flat = !(pair.prod >= options.degenerate_area_ratio);
-      bool inverted = false;
-      if (have_normals) {
-        // Inverted when the target triangle's normal points against the surface: compare with the
-        // sum of the three corners' unit normals (robust to one corner normal being off).
-        inverted = triangle_inverted(target_positions.col(a), target_positions.col(b),
-                                     target_positions.col(c), options.target_normals.col(a),
-                                     options.target_normals.col(b), options.target_normals.col(c));
+      bool excluded = false;
+      for (const int c : corners) {
+        excluded = excluded || skip[c] != 0;
       }
-      degenerate = degenerate || flat;
-      folded = folded || flat || inverted;
-      // The signed smallest singular value: negative for an inverted triangle (det J < 0).
-      sigma_min = std::min(sigma_min, inverted ? -pair.s2 : pair.s2);
+      if (excluded) {
+        fv.excluded[f] = 1;
+        continue;
+      }
+      bool folded = false, degenerate = false;
+      double sigma_min = inf;
+      for (const Eigen::Vector3i& local : face_triangulations(static_cast<int>(corners.size()))) {
+        const int a = corners[local[0]], b = corners[local[1]], c = corners[local[2]];
+        TrianglePair pair;
+        if (!analyse_pair(source.col(a), source.col(b), source.col(c), target_positions.col(a),
+                          target_positions.col(b), target_positions.col(c), sigma, pair)) {
+          throw InvalidInputError(
+              name, "grid face " + std::to_string(f) + " has a zero-area triangle on the source");
+        }
+        const bool flat = !(pair.prod >= options.degenerate_area_ratio);
+        bool inverted = false;
+        if (have_normals) {
+          // Inverted when the target triangle's normal points against the surface: compare with
+          // the sum of the three corners' unit normals (robust to one corner normal being off).
+          inverted =
+              triangle_inverted(target_positions.col(a), target_positions.col(b),
+                                target_positions.col(c), options.target_normals.col(a),
+                                options.target_normals.col(b), options.target_normals.col(c));
+        }
+        degenerate = degenerate || flat;
+        folded = folded || flat || inverted;
+        // The signed smallest singular value: negative for an inverted triangle (det J < 0).
+        sigma_min = std::min(sigma_min, inverted ? -pair.s2 : pair.s2);
+      }
+      fv.folded[f] = folded ? 1 : 0;
+      fv.sigma_min[f] = sigma_min;
+      sum.folds += folded ? 1 : 0;
+      sum.degenerate += degenerate ? 1 : 0;
+      sum.worst_sigma = std::min(sum.worst_sigma, sigma_min);
+      ++sum.judged;
     }
-    fv.folded[f] = folded ? 1 : 0;
-    fv.sigma_min[f] = sigma_min;
-    folds += folded ? 1 : 0;
-    out.degenerate += degenerate ? 1 : 0;
-    worst_sigma = std::min(worst_sigma, sigma_min);
-    ++judged_faces;
-  }
+    return sum;
+  };
+  const Judged judged = tbb::parallel_deterministic_reduce(
+      tbb::blocked_range<int>(0, static_cast<int>(grid.mesh.n_faces()), kGrain), Judged{}, judge,
+      [](Judged a, const Judged& b) {
+        a.folds += b.folds;
+        a.degenerate += b.degenerate;
+        a.judged += b.judged;
+        a.worst_sigma = std::min(a.worst_sigma, b.worst_sigma);
+        return a;
+      });
+  out.degenerate += judged.degenerate;
+  const int folds = judged.folds;
+  const int judged_faces = judged.judged;
+  const double worst_sigma = judged.worst_sigma;
   out.sigma_min = judged_faces > 0 ? worst_sigma : nan;
   return folds;
 }
@@ -295,6 +322,29 @@ struct TriangleSums {
   double max_s1 = 0.0, max_inv = 0.0;
   double angle_sum = 0.0;
   long angle_count = 0;
+  double angle_max = 0.0;
+  int measured = 0;
+  int excluded = 0;
+
+  // The sums of two ranges of triangles, the left one first.
+  static TriangleSums combine(TriangleSums a, const TriangleSums& b) {
+    a.w_sum += b.w_sum;
+    a.w_stretch += b.w_stretch;
+    a.w_area += b.w_area;
+    a.w_conf += b.w_conf;
+    a.w_sd += b.w_sd;
+    a.w_inv_sum += b.w_inv_sum;
+    a.w_inv_stretch += b.w_inv_stretch;
+    a.w_regular += b.w_regular;
+    a.max_s1 = std::max(a.max_s1, b.max_s1);
+    a.max_inv = std::max(a.max_inv, b.max_inv);
+    a.angle_sum += b.angle_sum;
+    a.angle_count += b.angle_count;
+    a.angle_max = std::max(a.angle_max, b.angle_max);
+    a.measured += b.measured;
+    a.excluded += b.excluded;
+    return a;
+  }
 };
 
 // The values of grid triangle t (not excluded) into out.per_triangle, and its share of the sums.
@@ -342,9 +392,9 @@ void measure_triangle(int t, const Eigen::Matrix3Xd& source,
     ++sums.angle_count;
   }
   tv.angle_error_deg[t] = worst;
-  out.angle_error_max_deg = std::max(out.angle_error_max_deg, worst);
+  sums.angle_max = std::max(sums.angle_max, worst);
 
-  ++out.measured_triangles;
+  ++sums.measured;
   const double w = source_area;
   sums.w_sum += w;
   sums.w_stretch += w * 0.5 * sum_sq;
@@ -430,16 +480,26 @@ MapMetrics measure_map(const ParticleGrid& grid, const Eigen::Matrix3Xd& target_
   fv.sigma_min.assign(nf, nan);
 
   const int folds = judge_faces(grid, source, target_positions, skip, options, name, out);
-  TriangleSums sums;
-  for (int t = 0; t < nt; ++t) {
-    const Eigen::Vector3i& tri = out.triangles[t];
-    if (skip[tri[0]] || skip[tri[1]] || skip[tri[2]]) {
-      tv.excluded[t] = 1;
-      ++out.outside_triangles;
-      continue;
-    }
-    measure_triangle(t, source, target_positions, options, name, out, sums);
-  }
+  // Each triangle writes its own entries; the sums are reduced over a split of the triangles that
+  // depends only on their number (parallel_deterministic_reduce), so not on the thread count.
+  const TriangleSums sums = tbb::parallel_deterministic_reduce(
+      tbb::blocked_range<int>(0, nt, kGrain), TriangleSums{},
+      [&](const tbb::blocked_range<int>& range, TriangleSums part) {
+        for (int t = range.begin(); t != range.end(); ++t) {
+          const Eigen::Vector3i& tri = out.triangles[t];
+          if (skip[tri[0]] || skip[tri[1]] || skip[tri[2]]) {
+            tv.excluded[t] = 1;
+            ++part.excluded;
+            continue;
+          }
+          measure_triangle(t, source, target_positions, options, name, out, part);
+        }
+        return part;
+      },
+      TriangleSums::combine);
+  out.outside_triangles += sums.excluded;
+  out.measured_triangles += sums.measured;
+  out.angle_error_max_deg = std::max(out.angle_error_max_deg, sums.angle_max);
   aggregate(sums, out);
   out.folds = options.target_normals.cols() > 0 ? folds : -1;
   return out;
@@ -450,12 +510,14 @@ Eigen::Matrix3Xd surface_normals(const LimitSurface& surface,
                                  const std::vector<char>& skip) {
   const int n = static_cast<int>(points.size());
   Eigen::Matrix3Xd normals = Eigen::Matrix3Xd::Zero(3, n);
-  for (int p = 0; p < n; ++p) {
-    if ((!skip.empty() && skip[p]) || !points[p].valid()) {
-      continue;
+  tbb::parallel_for(tbb::blocked_range<int>(0, n, kGrain), [&](const tbb::blocked_range<int>& r) {
+    for (int p = r.begin(); p != r.end(); ++p) {
+      if ((!skip.empty() && skip[p]) || !points[p].valid()) {
+        continue;
+      }
+      normals.col(p) = surface.curvature(points[p]).normal;
     }
-    normals.col(p) = surface.curvature(points[p]).normal;
-  }
+  });
   return normals;
 }
 
