@@ -12,6 +12,7 @@
 #include <string>
 #include <utility>
 
+#include "elastic/core/directed_edges.h"
 #include "elastic/core/error.h"
 #include "elastic/core/triangle_locator_2d.h"
 
@@ -34,47 +35,18 @@ constexpr int kMaxWalkSteps = 64;
 // neighbour holds the same edge reversed.
 std::vector<std::array<int, 3>> triangle_neighbours(const std::vector<Eigen::Vector3i>& triangles,
                                                     int num_particles) {
-  // The directed edges leaving each particle, grouped by a counting sort in triangle order
-  // (a hash map of every edge was 1.1 s of a million-particle map); a duplicated directed edge
-  // keeps its first triangle.
-  const auto n = static_cast<std::size_t>(num_particles);
-  std::vector<int> first(n + 1, 0);
-  for (const Eigen::Vector3i& tri : triangles) {
-    for (int k = 0; k < 3; ++k) {
-      ++first[static_cast<std::size_t>(tri[k]) + 1];
-    }
-  }
-  for (std::size_t v = 0; v < n; ++v) {
-    first[v + 1] += first[v];
-  }
-  struct Edge {
-    int to;
-    int triangle;
-  };
-  std::vector<Edge> out(static_cast<std::size_t>(first[n]));
-  std::vector<int> fill(first.begin(), first.end() - 1);
-  for (std::size_t t = 0; t < triangles.size(); ++t) {
-    const Eigen::Vector3i& tri = triangles[t];
-    for (int k = 0; k < 3; ++k) {
-      out[static_cast<std::size_t>(fill[static_cast<std::size_t>(tri[k])]++)] = {
-          tri[(k + 1) % 3], static_cast<int>(t)};
-    }
-  }
+  const DirectedEdges edges(triangles, num_particles);
   std::vector<std::array<int, 3>> neighbours(triangles.size(), {-1, -1, -1});
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, triangles.size(), 4096),
                     [&](const tbb::blocked_range<std::size_t>& r) {
                       for (std::size_t t = r.begin(); t != r.end(); ++t) {
                         const Eigen::Vector3i& tri = triangles[t];
                         for (int k = 0; k < 3; ++k) {
-                          // The neighbour across edge k (opposite corner k) holds it reversed.
-                          const auto from = static_cast<std::size_t>(tri[(k + 2) % 3]);
-                          const int to = tri[(k + 1) % 3];
-                          for (int e = first[from]; e < first[from + 1]; ++e) {
-                            if (out[static_cast<std::size_t>(e)].to == to) {
-                              neighbours[t][static_cast<std::size_t>(k)] =
-                                  out[static_cast<std::size_t>(e)].triangle;
-                              break;
-                            }
+                          // The neighbour across edge k (opposite corner k) holds it reversed; a
+                          // duplicated edge gives its first triangle.
+                          const int e = edges.find(tri[(k + 2) % 3], tri[(k + 1) % 3]);
+                          if (e >= 0) {
+                            neighbours[t][static_cast<std::size_t>(k)] = edges.triangle(e);
                           }
                         }
                       }

@@ -9,6 +9,7 @@
 #include <numeric>
 #include <unordered_map>
 
+#include "elastic/core/directed_edges.h"
 #include "elastic/core/error.h"
 #include "elastic/regions/texture_coordinates.h"
 
@@ -455,10 +456,8 @@ std::vector<std::vector<int>> CutMesh::components(const std::vector<char>* keep)
 
 PatchTopology patch_topology(const CutMesh& mesh, const std::vector<int>& tris) {
   PatchTopology topo;
-  // The patch's directed edges grouped by their first vertex (a counting sort), each vertex's
-  // targets sorted and made unique: the reverse of an edge is found among a few neighbours. This
-  // runs on every region (57,600 triangles for a whole cap) before any map; sorted 64-bit keys
-  // with a binary search per edge took 26-31 ms of it.
+  // The patch's directed edges grouped by the vertex they leave (core/directed_edges.h): this runs
+  // on every region (57,600 triangles for a whole cap) before any map.
   int top = -1;
   for (int t : tris) {
     const Eigen::Vector3i& v = mesh.triangles[static_cast<size_t>(t)];
@@ -468,60 +467,36 @@ PatchTopology patch_topology(const CutMesh& mesh, const std::vector<int>& tris) 
                            .cross(mesh.positions[static_cast<size_t>(v[2])] - x0)
                            .norm();
   }
-  const size_t nv = top < 0 ? 0 : static_cast<size_t>(top) + 1;
-  std::vector<int> start(nv + 1, 0);
-  for (int t : tris) {
-    for (int k = 0; k < 3; ++k) {
-      ++start[static_cast<size_t>(mesh.triangles[static_cast<size_t>(t)][k]) + 1];
-    }
-  }
-  for (size_t v = 0; v < nv; ++v) {
-    start[v + 1] += start[v];
-  }
-  std::vector<int> target(static_cast<size_t>(start[nv]));
-  std::vector<int> end(start.begin(), start.end() - 1);  // filled up, then the unique targets' end
-  for (int t : tris) {
-    const Eigen::Vector3i& v = mesh.triangles[static_cast<size_t>(t)];
-    for (int k = 0; k < 3; ++k) {
-      target[static_cast<size_t>(end[static_cast<size_t>(v[k])]++)] = v[(k + 1) % 3];
-    }
-  }
-  long vertices = 0, halfedges = 0;
-  for (size_t v = 0; v < nv; ++v) {
-    const auto first = target.begin() + start[v];
-    std::sort(first, target.begin() + end[v]);
-    end[v] = static_cast<int>(std::unique(first, target.begin() + end[v]) - target.begin());
-    vertices += end[v] > start[v] ? 1 : 0;  // every corner of a triangle has an outgoing edge
-    halfedges += end[v] - start[v];
-  }
-  const auto has_edge = [&](int a, int b) {
-    const auto last = target.begin() + end[static_cast<size_t>(a)];
-    return std::find(target.begin() + start[static_cast<size_t>(a)], last, b) != last;
-  };
-  // The boundary edge leaving each vertex (its smallest target), -1 where none; a second one
-  // out of the same vertex pinches the patch.
-  std::vector<int> next(nv, -1);
-  std::vector<int> boundary_from;
-  long interior_pairs = 0;
-  for (size_t a = 0; a < nv; ++a) {
-    for (int i = start[a]; i < end[a]; ++i) {
-      const int b = target[static_cast<size_t>(i)];
-      if (has_edge(b, static_cast<int>(a))) {
+  const DirectedEdges edges(mesh.triangles, top + 1, &tris);
+  // A boundary edge is one whose reverse is not in the patch; each vertex's `next` is the
+  // smallest end of its boundary edges, and a second one pinches the patch. An edge that two
+  // triangles repeat counts once.
+  std::vector<int> next(static_cast<size_t>(top + 1), -1);
+  long vertices = 0, halfedges = 0, interior_pairs = 0;
+  for (int a = 0; a <= top; ++a) {
+    vertices += edges.end(a) > edges.begin(a) ? 1 : 0;  // every corner has an outgoing edge
+    for (int e = edges.begin(a); e < edges.end(a); ++e) {
+      const int b = edges.to(e);
+      if (edges.find(a, b) != e) {
+        continue;  // a repeat of an earlier edge a -> b
+      }
+      ++halfedges;
+      if (edges.find(b, a) >= 0) {
         ++interior_pairs;
-      } else if (next[a] >= 0) {
-        topo.pinched = true;
+      } else if (next[static_cast<size_t>(a)] < 0) {
+        next[static_cast<size_t>(a)] = b;
       } else {
-        next[a] = b;
-        boundary_from.push_back(static_cast<int>(a));
+        topo.pinched = true;
+        next[static_cast<size_t>(a)] = std::min(next[static_cast<size_t>(a)], b);
       }
     }
   }
   const long boundary_edges = halfedges - interior_pairs;
-  const long edges = interior_pairs / 2 + boundary_edges;
-  topo.euler = static_cast<int>(vertices - edges + static_cast<long>(tris.size()));
-  std::vector<char> visited(nv, 0);
-  for (const int first : boundary_from) {
-    if (visited[static_cast<size_t>(first)]) {
+  const long edge_count = interior_pairs / 2 + boundary_edges;
+  topo.euler = static_cast<int>(vertices - edge_count + static_cast<long>(tris.size()));
+  std::vector<char> visited(next.size(), 0);
+  for (int first = 0; first <= top; ++first) {
+    if (next[static_cast<size_t>(first)] < 0 || visited[static_cast<size_t>(first)]) {
       continue;
     }
     std::vector<int> loop;
