@@ -23,6 +23,7 @@
 #include <Eigen/Core>
 #include <Eigen/SparseCholesky>
 #include <memory>
+#include <mutex>
 #include <string>
 #include <vector>
 
@@ -32,11 +33,12 @@ namespace elastic::regions_detail {
 
 class HeatGeodesics {
  public:
-  /// Builds and factors the heat operator. \throws NumericalError when the factorisation fails.
+  /// Builds the cotangent Laplacian and the mass; the heat operator is factored on first use.
   HeatGeodesics(const std::vector<Eigen::Vector3d>& positions,
                 const std::vector<Eigen::Vector3i>& triangles, std::string name);
 
   /// Heat u after one step from a point source.
+  /// \throws NumericalError when the factorisation of the heat operator fails.
   Eigen::VectorXd heat(const MeshLocation& source) const;
   /// Approximate geodesic distance from the source to every vertex.
   Eigen::VectorXd distance(const MeshLocation& source) const;
@@ -45,13 +47,18 @@ class HeatGeodesics {
 
  private:
   Eigen::Vector3d gradient(int t, const Eigen::VectorXd& f) const;
+  Eigen::VectorXd divergence(const Eigen::VectorXd& u) const;
+  Eigen::SparseMatrix<double> pinned_laplacian(int pin) const;
+  void factor_heat() const;
 
   const std::vector<Eigen::Vector3d>& x_;
   const std::vector<Eigen::Vector3i>& tri_;
   std::string name_;
   double h_ = 0.0;
-  Eigen::SparseMatrix<double> laplacian_;
-  std::unique_ptr<Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>>> heat_solver_;
+  Eigen::SparseMatrix<double> laplacian_;  // cotangent, positive semi-definite, every diagonal
+  Eigen::VectorXd mass_;                   // lumped (barycentric) mass per vertex
+  mutable std::once_flag heat_factored_;
+  mutable std::unique_ptr<Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>>> heat_solver_;
 };
 
 /// Heat-method distance from `source` that is exact (up to the method's own error) at every vertex
