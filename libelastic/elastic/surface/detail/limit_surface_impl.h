@@ -133,7 +133,7 @@ struct LimitSurface::Impl {
   void build_refiner(const LimitSurfaceOptions& options);
   void check_refiner_manifold() const;
   void build_ptex_numbering();
-  void build_patches(int isolation_level, int smooth_isolation_level);
+  void build_patches(int isolation, int smooth_isolation);
   void build_adjacency();
 
   void check_point(const SurfacePoint& p) const {
