@@ -4,6 +4,7 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <numeric>
 
@@ -68,17 +69,24 @@ CurvatureField::CurvatureField(const Region& region, double radius) : surface_(*
   std::vector<int> order(nv);
   std::iota(order.begin(), order.end(), 0);
   std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return key[a] < key[b]; });
-  position_.resize(nv);
+  px_.resize(nv);
+  py_.resize(nv);
+  pz_.resize(nv);
   weighted_r_.resize(nv);
   area_.resize(nv);
-  key_.resize(nv);
   for (int k = 0; k < nv; ++k) {
     const int v = order[k];
-    position_[k] = region.positions[v];
+    px_[k] = region.positions[v].x();
+    py_[k] = region.positions[v].y();
+    pz_[k] = region.positions[v].z();
     weighted_r_[k] = area[v] * r[v];
     area_[k] = area[v];
-    key_[k] = key[v];
+    if (k == 0 || key[v] != cell_keys_.back()) {
+      cell_keys_.push_back(key[v]);
+      cell_start_.push_back(k);
+    }
   }
+  cell_start_.push_back(nv);
 }
 
 std::uint64_t CurvatureField::cell_key(long ix, long iy, long iz) const {
@@ -93,7 +101,7 @@ double CurvatureField::at(const Eigen::Vector3d& x, const SurfacePoint& q) const
   if (constant_) {
     return *constant_;
   }
-  if (key_.empty()) {
+  if (cell_keys_.empty()) {
     return pointwise(surface_, q);
   }
   const Eigen::Vector3d c = (x - origin_) / cell_;
@@ -105,10 +113,16 @@ double CurvatureField::at(const Eigen::Vector3d& x, const SurfacePoint& q) const
     for (long dy = -1; dy <= 1; ++dy) {
       for (long dz = -1; dz <= 1; ++dz) {
         const std::uint64_t k = cell_key(ix + dx, iy + dy, iz + dz);
-        const auto range = std::equal_range(key_.begin(), key_.end(), k);
-        for (auto it = range.first; it != range.second; ++it) {
-          const auto v = static_cast<size_t>(it - key_.begin());
-          const double d2 = (position_[v] - x).squaredNorm();
+        const auto cell = std::lower_bound(cell_keys_.begin(), cell_keys_.end(), k);
+        if (cell == cell_keys_.end() || *cell != k) {
+          continue;
+        }
+        const auto index = static_cast<size_t>(cell - cell_keys_.begin());
+        const auto first = static_cast<size_t>(cell_start_[index]);
+        const auto last = static_cast<size_t>(cell_start_[index + 1]);
+        for (size_t v = first; v < last; ++v) {
+          const double ex = px_[v] - x.x(), ey = py_[v] - x.y(), ez = pz_[v] - x.z();
+          const double d2 = ex * ex + ey * ey + ez * ez;
           if (d2 < reach2) {
             const double t = 1.0 - d2 / reach2;
             const double g = t * t * t;

@@ -62,10 +62,14 @@ class CurvatureField {
   double radius_ = 0.0;
   double cell_ = 1.0;
   Eigen::Vector3d origin_ = Eigen::Vector3d::Zero();
-  std::vector<Eigen::Vector3d> position_;
+  std::vector<double> px_, py_, pz_;       // vertex positions by coordinate, sorted by cell
   std::vector<double> weighted_r_, area_;  // A_v r_v and A_v, sorted by cell
-  std::vector<std::uint64_t> key_;         // cell of each vertex, sorted
-  std::optional<double> constant_;         // r where it is the same at every vertex
+  // The occupied cells, sorted, and where each one's vertices start (one past the last: nv). A
+  // binary search over this short list stays in cache; one over every vertex's key (a few hundred
+  // thousand on a scan's region) missed it at each step and was most of the field's cost.
+  std::vector<std::uint64_t> cell_keys_;
+  std::vector<int> cell_start_;
+  std::optional<double> constant_;  // r where it is the same at every vertex
 };
 
 }  // namespace elastic
