@@ -1,5 +1,7 @@
 #include "elastic/mapping/map_regions.h"
 
+#include <tbb/parallel_invoke.h>
+
 #include <chrono>
 #include <optional>
 
@@ -327,10 +329,15 @@ MapResult map_cold(const SurfaceProjector& source, const Region& source_region,
   // 2. The naive map: both regions to the unit disk, composed (Fig. 9a).
   stage("naive map");
   start = std::chrono::steady_clock::now();
-  result.source_disk =
-      coarse ? std::move(coarse->source_disk) : std::make_unique<RegionDiskMap>(source_region);
-  result.target_disk =
-      coarse ? std::move(coarse->target_disk) : std::make_unique<RegionDiskMap>(target_region);
+  if (coarse) {
+    result.source_disk = std::move(coarse->source_disk);
+    result.target_disk = std::move(coarse->target_disk);
+  } else {
+    // The two disk maps are independent (a sparse solve each on its region): side by side.
+    tbb::parallel_invoke(
+        [&] { result.source_disk = std::make_unique<RegionDiskMap>(source_region); },
+        [&] { result.target_disk = std::make_unique<RegionDiskMap>(target_region); });
+  }
 
   // 3. Rest scale sigma between the two regions' sizes.
   result.rest_scale = region_rest_scale(options.rest_scale, source_region, target_region);
