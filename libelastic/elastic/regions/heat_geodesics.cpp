@@ -9,6 +9,7 @@
 #include <limits>
 #include <mutex>
 
+#include "elastic/core/directed_edges.h"
 #include "elastic/core/error.h"
 
 namespace elastic::regions_detail {
@@ -35,51 +36,37 @@ CotanParts cotan_parts(const std::vector<Eigen::Vector3d>& x,
   const auto double_area = [&](const Eigen::Vector3i& v) {
     return (at(v[1]) - at(v[0])).cross(at(v[2]) - at(v[0])).norm();
   };
-  // Pattern: each column's diagonal and the other corners of its non-degenerate triangles, by a
-  // counting sort, then each column sorted and deduplicated in place.
-  std::vector<int> start(static_cast<size_t>(nv) + 1, 0);
-  std::vector<char> flat(tri.size(), 0);
+  // Pattern: each column's diagonal and the other two corners of every non-degenerate triangle
+  // around it (DirectedEdges groups the triangles by vertex), sorted and deduplicated.
+  std::vector<int> solid;
+  solid.reserve(tri.size());
   for (size_t t = 0; t < tri.size(); ++t) {
-    flat[t] = double_area(tri[t]) == 0.0;
-    for (int k = 0; k < 3 && !flat[t]; ++k) {
-      start[static_cast<size_t>(tri[t][k]) + 1] += 2;
+    if (double_area(tri[t]) != 0.0) {
+      solid.push_back(static_cast<int>(t));
     }
   }
+  const DirectedEdges around(tri, nv, &solid);
+  std::vector<int> column(static_cast<size_t>(nv) + 1, 0), rows, neighbours;
+  rows.reserve(static_cast<size_t>(nv) + 6 * solid.size());
   for (int v = 0; v < nv; ++v) {
-    start[static_cast<size_t>(v) + 1] += start[static_cast<size_t>(v)] + 1;
-  }
-  std::vector<int> rows(static_cast<size_t>(start.back()));
-  std::vector<int> fill(start.begin(), start.end() - 1);
-  for (int v = 0; v < nv; ++v) {
-    rows[static_cast<size_t>(fill[static_cast<size_t>(v)]++)] = v;
-  }
-  for (size_t t = 0; t < tri.size(); ++t) {
-    for (int k = 0; k < 3 && !flat[t]; ++k) {
-      int& slot = fill[static_cast<size_t>(tri[t][k])];
-      rows[static_cast<size_t>(slot++)] = tri[t][(k + 1) % 3];
-      rows[static_cast<size_t>(slot++)] = tri[t][(k + 2) % 3];
+    neighbours.assign(1, v);
+    for (int e = around.begin(v); e < around.end(v); ++e) {
+      const Eigen::Vector3i& t = tri[static_cast<size_t>(around.triangle(e))];
+      neighbours.push_back(around.to(e));
+      neighbours.push_back(t.sum() - v - around.to(e));  // the triangle's third corner
     }
+    std::sort(neighbours.begin(), neighbours.end());
+    rows.insert(rows.end(), neighbours.begin(), std::unique(neighbours.begin(), neighbours.end()));
+    column[static_cast<size_t>(v) + 1] = static_cast<int>(rows.size());
   }
   CotanParts parts;
   Eigen::SparseMatrix<double>& lap = parts.laplacian;
   lap.resize(nv, nv);
   lap.makeCompressed();
-  int nnz = 0;
-  std::vector<int> column(static_cast<size_t>(nv) + 1, 0);
-  for (int v = 0; v < nv; ++v) {
-    const auto first = rows.begin() + start[static_cast<size_t>(v)];
-    auto last = rows.begin() + start[static_cast<size_t>(v) + 1];
-    std::sort(first, last);
-    last = std::unique(first, last);
-    column[static_cast<size_t>(v)] = nnz;
-    for (auto r = first; r != last; ++r) {
-      rows[static_cast<size_t>(nnz++)] = *r;  // compacted in place: nnz never passes first
-    }
-  }
-  column[static_cast<size_t>(nv)] = nnz;
+  const auto nnz = static_cast<Eigen::Index>(rows.size());
   lap.resizeNonZeros(nnz);
   std::copy(column.begin(), column.end(), lap.outerIndexPtr());
-  std::copy(rows.begin(), rows.begin() + nnz, lap.innerIndexPtr());
+  std::copy(rows.begin(), rows.end(), lap.innerIndexPtr());
   std::fill(lap.valuePtr(), lap.valuePtr() + nnz, -0.0);
   const auto entry = [&](int r, int c) -> double& {
     const int* first = lap.innerIndexPtr() + column[static_cast<size_t>(c)];

@@ -131,15 +131,14 @@ void substitute_phantom_points(std::array<Eigen::Vector3d, 16>& p, int boundary)
   }
 }
 
-/// The number of control points the gathered block holds (16 per regular patch).
+/// The number of control points the gathered block holds (each patch's own: 16 for a regular
+/// one, its phantom points substituted).
 size_t gathered_size(const Far::PatchTable& table) {
   size_t total_points = 0;
   for (int array = 0; array < table.GetNumPatchArrays(); ++array) {
-    const Far::PatchDescriptor desc = table.GetPatchArrayDescriptor(array);
-    const size_t per_patch = desc.GetType() == Far::PatchDescriptor::REGULAR
-                                 ? size_t{16}
-                                 : static_cast<size_t>(desc.GetNumControlVertices());
-    total_points += per_patch * static_cast<size_t>(table.GetNumPatches(array));
+    total_points +=
+        static_cast<size_t>(table.GetPatchArrayDescriptor(array).GetNumControlVertices()) *
+        static_cast<size_t>(table.GetNumPatches(array));
   }
   return total_points;
 }
@@ -186,7 +185,7 @@ void LimitSurface::Impl::build_patches(int isolation, int smooth_isolation) {
   for (int array = 0; array < patch_table->GetNumPatchArrays(); ++array) {
     const Far::PatchDescriptor desc = patch_table->GetPatchArrayDescriptor(array);
     const bool regular = desc.GetType() == Far::PatchDescriptor::REGULAR;
-    const int per_patch = regular ? 16 : desc.GetNumControlVertices();
+    const int per_patch = desc.GetNumControlVertices();  // 16 for a regular patch
     const int count = patch_table->GetNumPatches(array);
     tbb::parallel_for(
         tbb::blocked_range<int>(0, count, 1024), [&](const tbb::blocked_range<int>& r) {
