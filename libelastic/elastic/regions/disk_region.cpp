@@ -1,12 +1,17 @@
 // `disk:` regions (region_spec.h): the geodesic disk about a surface point, its boundary the
 // level set of the heat-method distance (regions/heat_geodesics.h) at the radius, cut exactly
 // into the tessellation near the disk.
+#include <tbb/parallel_for.h>
+
 #include <Eigen/Core>
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <sstream>
 #include <string>
+#include <unordered_map>
 #include <utility>
 #include <vector>
 
@@ -17,6 +22,14 @@
 
 namespace elastic::regions_detail {
 namespace {
+
+// A disk's level set is cut from the tessellation, so the disk is only as round as the tessellation
+// is fine about it: a radius of one or two edges cuts a polygon of a few dozen triangles with sharp
+// tips (a radius-5.7 disk on cylinder.obj, whose edges are about 4 long, came out a diamond of 30
+// triangles, and every map of it folded a tip). Below kMinRadiusInEdges mean edge lengths the
+// disk's neighbourhood is refined in (u, v) until the radius spans that many edges.
+constexpr double kMinRadiusInEdges = 6.0;
+constexpr int kMaxRefinementLevels = 6;
 
 // The edges of a triangle mesh once each, as (smaller, larger) vertex index, sorted.
 std::vector<std::pair<int, int>> mesh_edges(const std::vector<Eigen::Vector3i>& triangles) {
@@ -143,10 +156,134 @@ std::vector<char> below_zero_level(const CutMesh& cut, const std::vector<double>
   return inside;
 }
 
+// Mean edge length of the tessellation triangles `which` (each interior edge counted twice).
+double mean_edge_length(const LimitTessellation& tess, const std::vector<int>& which) {
+  double sum = 0.0;
+  for (const int t : which) {
+    const Eigen::Vector3i& v = tess.triangles[static_cast<size_t>(t)];
+    for (int k = 0; k < 3; ++k) {
+      sum += (tess.positions[static_cast<size_t>(v[(k + 1) % 3])] -
+              tess.positions[static_cast<size_t>(v[k])])
+                 .norm();
+    }
+  }
+  return which.empty() ? 0.0 : sum / (3.0 * static_cast<double>(which.size()));
+}
+
+// A piece of a tessellation with its corners' (u, v) and the disk's centre in it.
+struct UvPart {
+  LimitTessellation tess;
+  std::vector<std::array<Eigen::Vector2d, 3>> corner_uv;  ///< per triangle, in its ptex face
+  MeshLocation centre;
+};
+
+// The triangles `which` of `tess` (corners' (u, v) `which_uv`, in that order) as a mesh of their
+// own; `centre` (a location in `tess`) must lie in one of them.
+UvPart gather(const LimitTessellation& tess, std::vector<std::array<Eigen::Vector2d, 3>> which_uv,
+              const std::vector<int>& which, const MeshLocation& centre) {
+  UvPart part;
+  part.corner_uv = std::move(which_uv);
+  part.tess.resolution = tess.resolution;
+  std::unordered_map<int, int> local;
+  for (size_t i = 0; i < which.size(); ++i) {
+    const auto t = static_cast<size_t>(which[i]);
+    Eigen::Vector3i tri;
+    for (int k = 0; k < 3; ++k) {
+      const int v = tess.triangles[t][k];
+      const auto [it, added] = local.emplace(v, static_cast<int>(part.tess.positions.size()));
+      if (added) {
+        part.tess.positions.push_back(tess.positions[static_cast<size_t>(v)]);
+        part.tess.points.push_back(tess.points[static_cast<size_t>(v)]);
+      }
+      tri[k] = it->second;
+    }
+    part.tess.triangles.push_back(tri);
+    part.tess.triangle_face.push_back(tess.triangle_face[t]);
+    if (which[i] == centre.triangle) {
+      part.centre = {static_cast<int>(i), centre.bary};
+    }
+  }
+  return part;
+}
+
+// One level of refinement: every triangle split into four at its edges' midpoints in (u, v) of its
+// ptex face, so the new vertices lie on the limit surface and inside one face the (u, v) stay a
+// conforming triangulation, as CutMesh requires. An edge shared by two faces gets one vertex (its
+// surface point from the first triangle met); each triangle keeps the midpoint's (u, v) in its own
+// face.
+UvPart subdivide(const LimitSurface& surface, const UvPart& coarse) {
+  UvPart fine;
+  LimitTessellation& tess = fine.tess;
+  tess.positions = coarse.tess.positions;
+  tess.points = coarse.tess.points;
+  tess.resolution = 2 * coarse.tess.resolution;
+  std::unordered_map<std::uint64_t, int> midpoint;
+  const auto split = [&](int a, int b, int face, const Eigen::Vector2d& uv) {
+    const auto key = (static_cast<std::uint64_t>(std::min(a, b)) << 32) |
+                     static_cast<std::uint32_t>(std::max(a, b));
+    const auto [it, added] = midpoint.emplace(key, static_cast<int>(tess.points.size()));
+    if (added) {
+      tess.points.push_back(SurfacePoint{face, uv.x(), uv.y()});
+    }
+    return it->second;
+  };
+  for (size_t t = 0; t < coarse.tess.triangles.size(); ++t) {
+    const Eigen::Vector3i& v = coarse.tess.triangles[t];
+    const auto& uv = coarse.corner_uv[t];
+    const int face = coarse.tess.triangle_face[t];
+    const Eigen::Vector2d m01 = 0.5 * (uv[0] + uv[1]), m12 = 0.5 * (uv[1] + uv[2]),
+                          m20 = 0.5 * (uv[2] + uv[0]);
+    const int a = split(v[0], v[1], face, m01), b = split(v[1], v[2], face, m12),
+              c = split(v[2], v[0], face, m20);
+    // Three corner triangles and the middle one, all counter-clockwise like the parent.
+    tess.triangles.insert(tess.triangles.end(),
+                          {Eigen::Vector3i(v[0], a, c), Eigen::Vector3i(a, v[1], b),
+                           Eigen::Vector3i(c, b, v[2]), Eigen::Vector3i(a, b, c)});
+    fine.corner_uv.push_back({uv[0], m01, m20});
+    fine.corner_uv.push_back({m01, uv[1], m12});
+    fine.corner_uv.push_back({m20, m12, uv[2]});
+    fine.corner_uv.push_back({m01, m12, m20});
+    tess.triangle_face.insert(tess.triangle_face.end(), 4, face);
+  }
+  const size_t first_new = tess.positions.size();
+  tess.positions.resize(tess.points.size());
+  tbb::parallel_for(first_new, tess.points.size(),
+                    [&](size_t i) { tess.positions[i] = surface.position(tess.points[i]); });
+  // The centre: the piece of its triangle holding its (u, v).
+  const auto home = static_cast<size_t>(coarse.centre.triangle);
+  const Eigen::Vector2d centre_uv = interpolate(coarse.corner_uv[home], coarse.centre.bary);
+  double best = -std::numeric_limits<double>::infinity();
+  for (size_t t = 4 * home; t < 4 * home + 4; ++t) {
+    const Eigen::Vector3d b = barycentric_2d(fine.corner_uv[t], centre_uv);
+    if (b.minCoeff() > best) {
+      best = b.minCoeff();
+      fine.centre = {static_cast<int>(t), b.cwiseMax(0.0) / b.cwiseMax(0.0).sum()};
+    }
+  }
+  return fine;
+}
+
+// The triangles of `tess` with a corner closer than `reach` to `centre` (and the centre's own), by
+// the heat method's distance.
+std::vector<int> triangles_within(const LimitTessellation& tess, const MeshLocation& centre,
+                                  double reach, const std::string& name) {
+  const Eigen::VectorXd d =
+      local_geodesic_distance(tess.positions, tess.triangles, centre, reach, 4.0 * reach, name);
+  std::vector<int> near;
+  for (size_t t = 0; t < tess.triangles.size(); ++t) {
+    const Eigen::Vector3i& v = tess.triangles[t];
+    if (d[v[0]] < reach || d[v[1]] < reach || d[v[2]] < reach ||
+        static_cast<int>(t) == centre.triangle) {
+      near.push_back(static_cast<int>(t));
+    }
+  }
+  return near;
+}
+
 // The component of the sub-level set that holds the centre (the discrete field may have far-away
 // dips); refused when the disk is too small to hold a triangle of the cut there. `home` is the
 // centre's triangle among the cut mesh's original triangles (-1: not among them).
-int centre_component(const RegionContext& ctx, const CutMesh& cut,
+int centre_component(const RegionContext& ctx, const LimitTessellation& tess, const CutMesh& cut,
                      const std::vector<std::vector<int>>& comps, const MeshLocation& centre,
                      int home_triangle, double radius) {
   for (size_t c = 0; c < comps.size(); ++c) {
@@ -156,41 +293,20 @@ int centre_component(const RegionContext& ctx, const CutMesh& cut,
       }
     }
   }
-  const Eigen::Vector3i& home = ctx.tess.triangles[static_cast<size_t>(centre.triangle)];
-  double edge_sum = 0.0;
-  for (int k = 0; k < 3; ++k) {
-    edge_sum += (ctx.tess.positions[static_cast<size_t>(home[(k + 1) % 3])] -
-                 ctx.tess.positions[static_cast<size_t>(home[k])])
-                    .norm();
-  }
+  const double edge = mean_edge_length(tess, {centre.triangle});
   throw InvalidInputError(ctx.options.name,
                           "the disk of radius " + std::to_string(radius) +
                               " is too small for the surface's tessellation (edges about " +
-                              std::to_string(edge_sum / 3.0) + " long at the centre)");
+                              std::to_string(edge) + " long at the centre)");
 }
 
-}  // namespace
-
-Region disk_region(const RegionContext& ctx, const RegionSpec& spec) {
+// The disk cut from `tess` about `centre`: the level set of `part`'s phi (distance - R per part
+// vertex), with the corners' (u, v) `corner_uv` of `part`'s triangles.
+Region cut_disk(const RegionContext& ctx, const LimitTessellation& tess, DiskNeighbourhood& part,
+                std::vector<std::array<Eigen::Vector2d, 3>> corner_uv, const MeshLocation& centre,
+                double radius) {
   const std::string& name = ctx.options.name;
-  if (!(spec.radius > 0.0) || !std::isfinite(spec.radius)) {
-    throw InvalidInputError(name,
-                            "disk radius " + std::to_string(spec.radius) + " must be positive");
-  }
-  const MeshLocation centre =
-      ctx.project(spec.center, "disk centre", [&](const Eigen::Vector3d& q) {
-        std::ostringstream text;
-        text.precision(6);
-        text << "disk:" << q.x() << ',' << q.y() << ',' << q.z() << ',' << spec.radius;
-        return text.str();
-      });
-  // Vertices beyond the disk's reach get a distance of 4 R: outside, far from the level set.
-  const Eigen::VectorXd distance = local_geodesic_distance(
-      ctx.tess.positions, ctx.tess.triangles, centre, spec.radius, 4.0 * spec.radius, name);
-  // The level set phi = distance - R, cut exactly, in the disk's neighbourhood.
-  DiskNeighbourhood part = disk_neighbourhood(ctx.tess, distance, spec.radius);
-  CutMesh cut(ctx.surface, part.tess, tessellation_corner_uv(ctx.surface, ctx.tess, part.triangles),
-              name);
+  CutMesh cut(ctx.surface, part.tess, std::move(corner_uv), name);
   std::vector<double>& phi = part.phi;
   const std::vector<double> raw = phi;
   cut_zero_level(mesh_edges(part.tess.triangles), cut, phi);
@@ -200,16 +316,86 @@ Region disk_region(const RegionContext& ctx, const RegionSpec& spec) {
   const int home_triangle = home != part.triangles.end() && *home == centre.triangle
                                 ? static_cast<int>(home - part.triangles.begin())
                                 : -1;
-  const int chosen = centre_component(ctx, cut, comps, centre, home_triangle, spec.radius);
+  const int chosen = centre_component(ctx, tess, cut, comps, centre, home_triangle, radius);
   PatchTopology topo = patch_topology(cut, comps[static_cast<size_t>(chosen)]);
   if (topo.loops.empty()) {
-    throw InvalidInputError(name, "the disk of radius " + std::to_string(spec.radius) +
-                                      " covers the whole closed surface");
+    throw InvalidInputError(
+        name, "the disk of radius " + std::to_string(radius) + " covers the whole closed surface");
   }
   if (!topo.is_disk()) {
     throw_not_disk(name);
   }
   return make_region_from_patch(cut, comps[static_cast<size_t>(chosen)], topo);
+}
+
+// How many times the disk's neighbourhood is refined (subdivide) so that the radius spans
+// kMinRadiusInEdges mean edges of `part` (of the centre's triangle when the disk holds no vertex).
+int refinement_levels(const LimitTessellation& tess, const DiskNeighbourhood& part,
+                      const MeshLocation& centre, double radius, double* edge) {
+  *edge = part.triangles.empty() ? mean_edge_length(tess, {centre.triangle})
+                                 : mean_edge_length(tess, part.triangles);
+  int levels = 0;
+  while (levels < kMaxRefinementLevels &&
+         radius * std::ldexp(1.0, levels) < kMinRadiusInEdges * *edge) {
+    ++levels;
+  }
+  return levels;
+}
+
+}  // namespace
+
+Region disk_region(const RegionContext& ctx, const RegionSpec& spec) {
+  const std::string& name = ctx.options.name;
+  const double radius = spec.radius;
+  if (!(radius > 0.0) || !std::isfinite(radius)) {
+    throw InvalidInputError(name, "disk radius " + std::to_string(radius) + " must be positive");
+  }
+  const MeshLocation centre =
+      ctx.project(spec.center, "disk centre", [&](const Eigen::Vector3d& q) {
+        std::ostringstream text;
+        text.precision(6);
+        text << "disk:" << q.x() << ',' << q.y() << ',' << q.z() << ',' << radius;
+        return text.str();
+      });
+  // Vertices beyond the disk's reach get a distance of 4 R: outside, far from the level set.
+  const Eigen::VectorXd distance = local_geodesic_distance(ctx.tess.positions, ctx.tess.triangles,
+                                                           centre, radius, 4.0 * radius, name);
+  // The level set phi = distance - R, cut exactly, in the disk's neighbourhood.
+  DiskNeighbourhood part = disk_neighbourhood(ctx.tess, distance, radius);
+  double edge = 0.0;
+  const int levels = refinement_levels(ctx.tess, part, centre, radius, &edge);
+  if (levels == 0) {
+    return cut_disk(ctx, ctx.tess, part,
+                    tessellation_corner_uv(ctx.surface, ctx.tess, part.triangles), centre, radius);
+  }
+  // A disk of few edges: its neighbourhood out to R + max(R, 2 edges) (the distance errs by about
+  // an edge), refined one level at a time, each level's neighbourhood chosen by the distance on the
+  // level before, so the work follows the disk's size in the finest edges.
+  const auto reach = [&] { return radius + std::max(radius, 2.0 * edge); };
+  std::vector<int> near = triangles_within(ctx.tess, centre, reach(), name);
+  UvPart fine = gather(ctx.tess, tessellation_corner_uv(ctx.surface, ctx.tess, near), near, centre);
+  for (int level = 1; level <= levels; ++level) {
+    fine = subdivide(ctx.surface, fine);
+    edge *= 0.5;
+    if (level < levels) {
+      near = triangles_within(fine.tess, fine.centre, reach(), name);
+      std::vector<std::array<Eigen::Vector2d, 3>> near_uv;
+      near_uv.reserve(near.size());
+      for (const int t : near) {
+        near_uv.push_back(fine.corner_uv[static_cast<size_t>(t)]);
+      }
+      fine = gather(fine.tess, std::move(near_uv), near, fine.centre);
+    }
+  }
+  const Eigen::VectorXd fine_distance = local_geodesic_distance(
+      fine.tess.positions, fine.tess.triangles, fine.centre, radius, 4.0 * radius, name);
+  DiskNeighbourhood fine_part = disk_neighbourhood(fine.tess, fine_distance, radius);
+  std::vector<std::array<Eigen::Vector2d, 3>> corner_uv;
+  corner_uv.reserve(fine_part.triangles.size());
+  for (const int t : fine_part.triangles) {
+    corner_uv.push_back(fine.corner_uv[static_cast<size_t>(t)]);
+  }
+  return cut_disk(ctx, fine.tess, fine_part, std::move(corner_uv), fine.centre, radius);
 }
 
 }  // namespace elastic::regions_detail
