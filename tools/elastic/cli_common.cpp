@@ -24,22 +24,38 @@ bool g_line_open = false;
 }
 
 LoadedSurface load_surface(const std::string& path, const std::string& scheme) {
-  MeshReadResult read = read_mesh(path);
-  LoadedSurface loaded = surface_from_mesh(std::move(read.mesh), path, scheme);
-  loaded.warnings.insert(loaded.warnings.begin(), read.warnings.begin(), read.warnings.end());
+  LoadedSurface loaded = read_surface_mesh(path);
+  build_limit_surface(loaded, scheme);
   return loaded;
 }
 
 LoadedSurface surface_from_mesh(PolygonMesh mesh, const std::string& path,
                                 const std::string& scheme) {
+  LoadedSurface loaded = sanitised_mesh(std::move(mesh), path);
+  build_limit_surface(loaded, scheme);
+  return loaded;
+}
+
+LoadedSurface read_surface_mesh(const std::string& path) {
+  MeshReadResult read = read_mesh(path);
+  return sanitised_mesh(std::move(read.mesh), path, std::move(read.warnings));
+}
+
+LoadedSurface sanitised_mesh(PolygonMesh mesh, const std::string& path,
+                             std::vector<std::string> warnings) {
   LoadedSurface loaded;
   loaded.path = path;
+  loaded.warnings = std::move(warnings);
   loaded.mesh = std::make_shared<PolygonMesh>(std::move(mesh));
   SanitizeResult sanitized = sanitize_mesh(*loaded.mesh, path);
   loaded.warnings.insert(loaded.warnings.end(), sanitized.warnings.begin(),
                          sanitized.warnings.end());
+  return loaded;
+}
+
+void build_limit_surface(LoadedSurface& loaded, const std::string& scheme) {
   LimitSurfaceOptions options;
-  options.name = path;
+  options.name = loaded.path;
   if (scheme == "loop") {
     options.scheme = SubdivisionScheme::Loop;
   }
@@ -48,7 +64,6 @@ LoadedSurface surface_from_mesh(PolygonMesh mesh, const std::string& path,
   }
   loaded.surface = std::make_shared<LimitSurface>(*loaded.mesh, options);
   loaded.projector = std::make_shared<SurfaceProjector>(*loaded.surface);
-  return loaded;
 }
 
 namespace {
