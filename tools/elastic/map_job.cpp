@@ -574,6 +574,10 @@ nlohmann::json map_report(const MapJob& job, const MapSession& session,
         {"spacing_median", s.spacing_median},
         {"spacing_max", s.spacing_max},
         {"density_ratio", s.density_ratio},
+        // Faces of the source grid with a corner turned over against the source's normal: the
+        // grid does not follow the region there (a protrusion narrower than its spacing).
+        {"inverted_faces", s.inverted_faces},
+        {"min_corner_sine", s.min_corner_sine},
         // The adaptive sampling's own iteration (§4.3): a scan's creases can keep it from
         // settling (docs/sampling.md); the map is judged on its own all the same.
         {"iterations", r.sampling.sampling.iterations},

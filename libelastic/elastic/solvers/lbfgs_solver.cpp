@@ -17,6 +17,7 @@
 #include "elastic/core/huge_pages.h"
 #include "elastic/solvers/newton_preconditioner.h"
 #include "elastic/solvers/solver_common.h"
+#include "elastic/solvers/stagnation.h"
 
 namespace elastic {
 
@@ -357,6 +358,15 @@ class LbfgsRun {
     }
     if (settled()) {
       result_.reason = StopReason::Settled;
+      return true;
+    }
+    // No progress in any phase (stagnation.h): a run that goes nowhere stops instead of spending
+    // its budget. A 5,000-particle map of a camel head's ear region onto bob spent 1,950
+    // iterations (127 s) at one energy, falling by 3e-9 of itself per 100 iterations with the
+    // gradient unchanged (a sliver the barrier holds open while every step has to be shortened to
+    // keep the faces unfolded); the map fails either way, now in 57 s instead of 200.
+    if (stagnation_.stagnated(energies_.total(), q_norm_)) {
+      result_.reason = StopReason::Stagnated;
       return true;
     }
     if (!report_progress(options_.progress, {.stage = "relax",
@@ -810,6 +820,7 @@ class LbfgsRun {
 
   long iteration_ = 0;
   std::deque<double> recent_;  // energies of the last iterates (settled())
+  solver_detail::StagnationMonitor stagnation_;
   int stalled_ = 0;  // consecutive steps that changed the energy by less than its round-off
   bool at_round_off_ = false;
 };

@@ -96,6 +96,8 @@ std::string_view to_string(StopReason reason) {
       return "cancelled";
     case StopReason::Settled:
       return "energy settled";
+    case StopReason::Stagnated:
+      return "no progress (neither the energy nor the gradient improved over 100 iterations)";
   }
   return "unknown";
 }

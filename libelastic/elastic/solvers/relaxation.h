@@ -62,10 +62,17 @@ enum class StopReason {
   Cancelled,         ///< not converged: the progress callback asked to stop
   /// the slide phase of a sliding boundary only (L-BFGS): its energy fell by less than
   /// RelaxationOptions::slide_settle_tolerance over the last kSettleWindow iterations
-  Settled
+  Settled,
+  /// not converged (L-BFGS): over the last kStagnationWindow iterations the energy fell by less
+  /// than kStagnationEnergy of itself and the smallest tangential gradient did not fall by 10%
+  Stagnated
 };
 /// Iterations over which RelaxationOptions::slide_settle_tolerance is judged.
 inline constexpr long kSettleWindow = 20;
+/// Iterations over which StopReason::Stagnated is judged, and the energy's relative fall below
+/// which a window counts as no progress.
+inline constexpr long kStagnationWindow = 100;
+inline constexpr double kStagnationEnergy = 1e-8;
 
 /// A short lower-case description, e.g. "relative tangential gradient below tolerance".
 std::string_view to_string(StopReason reason);
