@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <cmath>
 
-#include "elastic/solvers/nested_dissection.h"
 #include "elastic/solvers/solver_common.h"
 
 namespace elastic::solver_detail {
@@ -27,9 +26,7 @@ void tangent_pair(const Eigen::Vector3d& n, Eigen::Vector3d& e1, Eigen::Vector3d
 
 NewtonPreconditioner::NewtonPreconditioner(const RelaxationSetup& setup,
                                            const Eigen::SparseMatrix<double>& laplacian)
-    : setup_(&setup),
-      laplacian_(laplacian),
-      order_(nested_dissection_order(laplacian_, interior_coordinates(setup))) {}
+    : setup_(&setup), laplacian_(laplacian) {}
 
 bool NewtonPreconditioner::refresh(const Eigen::Matrix3Xd& positions,
                                    const Eigen::Matrix3Xd& normals,
@@ -49,8 +46,8 @@ bool NewtonPreconditioner::refresh(const Eigen::Matrix3Xd& positions,
   return ready_;
 }
 
-// B: the free entries in nested-dissection order (so that K needs no further ordering), two
-// tangent vectors each, or the curve's tangent for a sliding boundary particle, none when held.
+// B: the free entries in order, two tangent vectors each, or the curve's tangent for a sliding
+// boundary particle, none when held.
 void NewtonPreconditioner::build_basis(const Eigen::Matrix3Xd& normals,
                                        const Eigen::Matrix3Xd& tangents,
                                        const std::vector<char>& held) {
@@ -59,14 +56,15 @@ void NewtonPreconditioner::build_basis(const Eigen::Matrix3Xd& normals,
   basis_.first.assign(particles, 0);
   basis_.count.assign(particles, 0);
   Eigen::Index size = 0;
-  for (const int k : order_) {
+  const int free = static_cast<int>(setup.interior.size());
+  for (int k = 0; k < free; ++k) {
     if (held[static_cast<std::size_t>(k)] == 0) {
       size += setup.sliding[static_cast<std::size_t>(k)] >= 0 ? 1 : 2;
     }
   }
   basis_.vectors.resize(3, size);
   int next = 0;
-  for (const int k : order_) {
+  for (int k = 0; k < free; ++k) {
     if (held[static_cast<std::size_t>(k)] != 0) {
       continue;
     }
