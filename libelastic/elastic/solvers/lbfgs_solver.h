@@ -59,9 +59,10 @@
 /// source region mapped onto a round target boundary with 2,000 particles: its 90-degree corners
 /// must open to 180 degrees, and the explicit solver run to equilibrium folds faces next to them.
 /// When no trial is accepted with an empty memory, or 20 steps in a row change the energy by less
-/// than 1e-14 E, it stops with StopReason::LineSearchFailed. In any phase it stops with StopReason::Stagnated
-/// (not converged) when kStagnationWindow iterations lowered the energy by less than
-/// kStagnationEnergy of it and did not lower the smallest tangential gradient so far by 10%.
+/// than 1e-14 E, it stops with StopReason::LineSearchFailed. In any phase it stops with
+/// StopReason::Stagnated (not converged) when kStagnationWindow iterations lowered the energy by
+/// less than kStagnationEnergy of it and did not lower the smallest tangential gradient so far by
+/// 10%.
 
 #include "elastic/solvers/relaxation.h"
 
