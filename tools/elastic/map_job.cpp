@@ -304,62 +304,59 @@ void load_sides(const MapJob& job, MapSession& s, std::optional<MeshReadResult> 
     return found != cache->end();
   };
   std::exception_ptr source_error, target_error;
-  const auto read_source = [&] {
-    try {
-      if (!source_built) {
-        source = s.image ? sanitised_mesh(s.image->mesh, job.source_image)
-                         : read_surface_mesh(job.source);
+  // Runs `work`, keeping what it throws in `error` (the other side goes on).
+  const auto guarded = [](std::exception_ptr& error, const auto& work) {
+    return [&error, &work] {
+      try {
+        work();
+      } catch (...) {
+        error = std::current_exception();
       }
-    } catch (...) {
-      source_error = std::current_exception();
+    };
+  };
+  const auto read_source_mesh = [&] {
+    if (!source_built) {
+      source =
+          s.image ? sanitised_mesh(s.image->mesh, job.source_image) : read_surface_mesh(job.source);
     }
   };
-  const auto read_target = [&] {
-    try {
-      if (!target_built) {
-        target = target_read ? sanitised_mesh(std::move(target_read->mesh), job.target,
-                                              std::move(target_read->warnings))
-                             : read_surface_mesh(job.target);
-      }
-    } catch (...) {
-      target_error = std::current_exception();
+  const auto read_target_mesh = [&] {
+    if (!target_built) {
+      target = target_read ? sanitised_mesh(std::move(target_read->mesh), job.target,
+                                            std::move(target_read->warnings))
+                           : read_surface_mesh(job.target);
     }
   };
-  const auto build_source = [&] {
-    try {
-      if (!source_built) {
-        build_limit_surface(source, job.scheme);
-        if (cache != nullptr) {
-          cache->emplace(source_key, source);
-        }
+  // The limit surface (cached when there is a cache) unless found there, then the region.
+  const auto build = [&](LoadedSurface& loaded, bool built, const std::string& key) {
+    if (!built) {
+      build_limit_surface(loaded, job.scheme);
+      if (cache != nullptr) {
+        cache->emplace(key, loaded);
       }
-      s.source = source;
-      s.source_region = side_region(
-          *s.source.projector,
-          s.image ? s.image->region : parse_region_flag(job.source_region, "--source-region"),
-          job.source_anchor, "source");
-    } catch (...) {
-      source_error = std::current_exception();
     }
   };
-  const auto build_target = [&] {
-    try {
-      if (!target_built) {
-        build_limit_surface(target, job.scheme);
-        if (cache != nullptr) {
-          cache->emplace(target_key, target);
-        }
-      }
-      s.target = target;
-      if (job.target_place.empty()) {
-        s.target_region = side_region(*s.target.projector,
-                                      parse_region_flag(job.target_region, "--target-region"),
-                                      job.target_anchor, "target");
-      }
-    } catch (...) {
-      target_error = std::current_exception();
+  const auto build_source_side = [&] {
+    build(source, source_built, source_key);
+    s.source = source;
+    s.source_region = side_region(
+        *s.source.projector,
+        s.image ? s.image->region : parse_region_flag(job.source_region, "--source-region"),
+        job.source_anchor, "source");
+  };
+  const auto build_target_side = [&] {
+    build(target, target_built, target_key);
+    s.target = target;
+    if (job.target_place.empty()) {
+      s.target_region =
+          side_region(*s.target.projector, parse_region_flag(job.target_region, "--target-region"),
+                      job.target_anchor, "target");
     }
   };
+  const auto read_source = guarded(source_error, read_source_mesh);
+  const auto read_target = guarded(target_error, read_target_mesh);
+  const auto build_source = guarded(source_error, build_source_side);
+  const auto build_target = guarded(target_error, build_target_side);
   const auto rethrow = [&] {
     if (source_error) {
       std::rethrow_exception(source_error);

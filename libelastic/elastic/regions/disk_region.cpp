@@ -58,37 +58,52 @@ struct DiskNeighbourhood {
   std::vector<double> phi;     ///< distance - R per part vertex
 };
 
+// The triangles `which` (increasing) of `tess` as a tessellation of their own, its vertices in
+// `tess`'s relative order; `vertex[i]` is the `tess` vertex of local vertex i.
+LimitTessellation sub_tessellation(const LimitTessellation& tess, const std::vector<int>& which,
+                                   std::vector<int>& vertex) {
+  LimitTessellation part;
+  std::vector<int> local(tess.positions.size(), -1);
+  for (const int t : which) {
+    for (int k = 0; k < 3; ++k) {
+      local[static_cast<size_t>(tess.triangles[static_cast<size_t>(t)][k])] = 0;
+    }
+  }
+  vertex.clear();
+  for (size_t v = 0; v < local.size(); ++v) {
+    if (local[v] == 0) {
+      local[v] = static_cast<int>(vertex.size());
+      vertex.push_back(static_cast<int>(v));
+      part.positions.push_back(tess.positions[v]);
+      part.points.push_back(tess.points[v]);
+    }
+  }
+  part.resolution = tess.resolution;
+  part.triangles.reserve(which.size());
+  part.triangle_face.reserve(which.size());
+  for (const int t : which) {
+    const Eigen::Vector3i& v = tess.triangles[static_cast<size_t>(t)];
+    part.triangles.emplace_back(local[static_cast<size_t>(v[0])], local[static_cast<size_t>(v[1])],
+                                local[static_cast<size_t>(v[2])]);
+    part.triangle_face.push_back(tess.triangle_face[static_cast<size_t>(t)]);
+  }
+  return part;
+}
+
 DiskNeighbourhood disk_neighbourhood(const LimitTessellation& tess, const Eigen::VectorXd& distance,
                                      double radius) {
   DiskNeighbourhood part;
-  std::vector<int> local(tess.positions.size(), -1);
   for (size_t t = 0; t < tess.triangles.size(); ++t) {
     const Eigen::Vector3i& v = tess.triangles[t];
     if (distance[v[0]] < radius || distance[v[1]] < radius || distance[v[2]] < radius) {
       part.triangles.push_back(static_cast<int>(t));
-      for (int k = 0; k < 3; ++k) {
-        local[static_cast<size_t>(v[k])] = 0;
-      }
     }
   }
-  int next = 0;
-  for (size_t v = 0; v < local.size(); ++v) {
-    if (local[v] == 0) {
-      local[v] = next++;
-      part.tess.positions.push_back(tess.positions[v]);
-      part.tess.points.push_back(tess.points[v]);
-      part.phi.push_back(distance[static_cast<Eigen::Index>(v)] - radius);
-    }
-  }
-  part.tess.resolution = tess.resolution;
-  part.tess.triangles.reserve(part.triangles.size());
-  part.tess.triangle_face.reserve(part.triangles.size());
-  for (const int t : part.triangles) {
-    const Eigen::Vector3i& v = tess.triangles[static_cast<size_t>(t)];
-    part.tess.triangles.emplace_back(local[static_cast<size_t>(v[0])],
-                                     local[static_cast<size_t>(v[1])],
-                                     local[static_cast<size_t>(v[2])]);
-    part.tess.triangle_face.push_back(tess.triangle_face[static_cast<size_t>(t)]);
+  std::vector<int> vertex;
+  part.tess = sub_tessellation(tess, part.triangles, vertex);
+  part.phi.reserve(vertex.size());
+  for (const int v : vertex) {
+    part.phi.push_back(distance[v] - radius);
   }
   return part;
 }
@@ -177,32 +192,16 @@ struct UvPart {
   MeshLocation centre;
 };
 
-// The triangles `which` of `tess` (corners' (u, v) `which_uv`, in that order) as a mesh of their
-// own; `centre` (a location in `tess`) must lie in one of them.
+// The triangles `which` (increasing) of `tess`, corners' (u, v) `which_uv` in that order, as a mesh
+// of their own (sub_tessellation); `centre` (a location in `tess`) must lie in one of them.
 UvPart gather(const LimitTessellation& tess, std::vector<std::array<Eigen::Vector2d, 3>> which_uv,
               const std::vector<int>& which, const MeshLocation& centre) {
   UvPart part;
+  std::vector<int> vertex;
+  part.tess = sub_tessellation(tess, which, vertex);
   part.corner_uv = std::move(which_uv);
-  part.tess.resolution = tess.resolution;
-  std::unordered_map<int, int> local;
-  for (size_t i = 0; i < which.size(); ++i) {
-    const auto t = static_cast<size_t>(which[i]);
-    Eigen::Vector3i tri;
-    for (int k = 0; k < 3; ++k) {
-      const int v = tess.triangles[t][k];
-      const auto [it, added] = local.emplace(v, static_cast<int>(part.tess.positions.size()));
-      if (added) {
-        part.tess.positions.push_back(tess.positions[static_cast<size_t>(v)]);
-        part.tess.points.push_back(tess.points[static_cast<size_t>(v)]);
-      }
-      tri[k] = it->second;
-    }
-    part.tess.triangles.push_back(tri);
-    part.tess.triangle_face.push_back(tess.triangle_face[t]);
-    if (which[i] == centre.triangle) {
-      part.centre = {static_cast<int>(i), centre.bary};
-    }
-  }
+  const auto home = std::lower_bound(which.begin(), which.end(), centre.triangle);
+  part.centre = {static_cast<int>(home - which.begin()), centre.bary};
   return part;
 }
 
