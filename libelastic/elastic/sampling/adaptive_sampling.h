@@ -30,7 +30,9 @@
 /// A move that would invert or nearly collapse a face (a corner whose sine, measured against the
 /// surface normal at that corner, drops to <= `min_corner_sine` and below its previous value) is
 /// halved once and otherwise rejected for that iteration; moves are accepted particle by particle
-/// in index order, so the result does not depend on the number of threads.
+/// in index order, so the result does not depend on the number of threads. Around a face that is
+/// already turned over (a layout can leave a few in a crease of a scan) the test is made face by
+/// face: that face may change (and unfold), the particle's other faces keep the rule.
 ///
 /// Iterations stop when the largest move is below `tolerance` times the mean spring length, after
 /// `max_iterations`, when the Newton steps stall (below), or when the progress callback asks to
@@ -46,13 +48,13 @@
 /// preconditioned conjugate gradients (numerics/conjugate_gradient.h; preconditioner: a multigrid
 /// V-cycle of the scalar weighted Laplacian, numerics/multigrid.h), puts the particles back on the
 /// surface (the magnet), and is accepted as a whole when no face corner turns or thins as above
-/// (else half, then a quarter of it; if all three fail, the full step is taken with the particles
-/// of the failing faces held still for that iteration, and as a last resort with each particle's
-/// move guarded as in a sweep). An iteration whose largest move does not shrink by 10% halves the
-/// following steps (down to 1/16): on a scan the fixed point can cycle between two states. The
-/// weights are then re-evaluated, so the iteration is a fixed point on
-/// w with a Newton step inside (it contracted by about 3x per step on spot.obj); its fixed point is
-/// eq. 8's. Newton steps hold the boundary particles at their equal-arc-length layout
+/// (else half, then a quarter of it; if all three fail, the quarter step is taken with the
+/// particles of the failing faces held still for that iteration, and as a last resort with each
+/// particle's move guarded as in a sweep). An iteration whose largest move does not shrink by 10%
+/// halves the following steps (down to 1/16): on a scan the fixed point can cycle between two
+/// states. The weights are then re-evaluated, so the iteration is a fixed point on w with a Newton
+/// step inside (it contracted by about 3x per step on spot.obj); its fixed point is eq. 8's. Newton
+/// steps hold the boundary particles at their equal-arc-length layout
 /// (`move_boundary` applies to the sweeps): with sliding boundary unknowns the step follows the
 /// near-null mode of a disk's rotation (11 spacings in one step on spot.obj), and sliding after
 /// each step drifted by 0.1 spacing per step without converging. A Jacobi step diffuses
