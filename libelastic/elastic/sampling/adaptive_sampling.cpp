@@ -263,8 +263,8 @@ double Sampler::min_sine_around(int p) const {
 // sine, so neither it nor any neighbour sharing the face could move again, and no Newton step
 // could be taken whole (camelhead.off's head, 5,000 particles: all 93 iterations ended in the
 // particle-by-particle fallback). For such a particle the guard is applied face by face instead:
-// a turned-over face may not get worse (it may unfold), every other face keeps the rule. Where no
-// face is turned over the test is the particle's smallest sine, as always.
+// a turned-over face may change (and unfold), every other face keeps the rule. Where no face is
+// turned over the test is the particle's smallest sine, as always.
 template <typename FaceBefore>
 bool Sampler::move_acceptable(int p, double before, const FaceBefore& face_before) const {
   const double min_sine = options_.min_corner_sine;
@@ -616,12 +616,20 @@ bool Sampler::newton_step(double& largest) {
       return false;  // an interior part not tied to the boundary: the sweeps handle it
     }
   }
-  std::vector<double> before(np_);
-  tbb::parallel_for(0, np_, [&](int p) { before[p] = min_sine_around(p); });
+  // Each face's smallest corner sine before the step, and each particle's over its faces (the
+  // same values as min_sine_around: a minimum is exact in any order).
   const int num_faces = faces_.nodes();
   std::vector<double> before_face(static_cast<size_t>(num_faces));
   tbb::parallel_for(0, num_faces, [&](int f) { before_face[f] = face_min_sine(f); });
   const auto face_before = [&](int f) { return before_face[f]; };
+  std::vector<double> before(np_);
+  tbb::parallel_for(0, np_, [&](int p) {
+    double m = 1.0;
+    for (int k = vertex_faces_.start[p]; k < vertex_faces_.start[p + 1]; ++k) {
+      m = std::min(m, before_face[vertex_faces_.items[k]]);
+    }
+    before[p] = m;
+  });
   std::vector<SurfacePoint>& sp = grid_.source_points;
   const std::vector<Eigen::Vector3d> old_x = x_, old_n = normal_;
   const std::vector<SurfacePoint> old_sp = sp;
