@@ -277,25 +277,15 @@ int CutMesh::insert_in_triangle(int tri, Eigen::Vector3d bary, double snap) {
 }
 
 int CutMesh::insert_point(int origin_triangle, const Eigen::Vector2d& p, double snap) {
-  int best = -1;
-  double best_min = -std::numeric_limits<double>::infinity();
-  Eigen::Vector3d best_bary = Eigen::Vector3d::Zero();
-  for (int t : children[static_cast<size_t>(origin_triangle)]) {
-    const Eigen::Vector3d b = barycentric_2d(uv[static_cast<size_t>(t)], p);
-    if (b.isZero()) {
-      continue;
-    }
-    if (b.minCoeff() > best_min) {
-      best_min = b.minCoeff();
-      best = t;
-      best_bary = b;
-    }
-  }
-  if (best < 0) {
+  const std::vector<int>& candidates = children[static_cast<size_t>(origin_triangle)];
+  const MeshLocation best = deepest_triangle(
+      candidates, [&](size_t i) -> const auto& { return uv[static_cast<size_t>(candidates[i])]; },
+      p);
+  if (best.triangle < 0) {
     throw NumericalError(name_, "internal: cannot locate a curve point in its triangle");
   }
-  best_bary = best_bary.cwiseMax(0.0);
-  return insert_in_triangle(best, best_bary / best_bary.sum(), snap);
+  const Eigen::Vector3d b = best.bary.cwiseMax(0.0);
+  return insert_in_triangle(best.triangle, b / b.sum(), snap);
 }
 
 Eigen::Vector2d CutMesh::chart_coordinate(Chart chart, int t, int v) const {

@@ -14,6 +14,7 @@
 
 #include <Eigen/Core>
 #include <array>
+#include <limits>
 #include <set>
 #include <string>
 #include <utility>
@@ -49,6 +50,26 @@ inline Eigen::Vector2d interpolate(const std::array<Eigen::Vector2d, 3>& uv,
 }
 /// Barycentric coordinates of p in the planar triangle (a, b, c); zeros for a degenerate triangle.
 Eigen::Vector3d barycentric_2d(const std::array<Eigen::Vector2d, 3>& tri, const Eigen::Vector2d& p);
+
+/// The triangle among `candidates` that holds the (u, v) point `p` most deeply: the largest
+/// smallest barycentric coordinate, so that a point on an edge, or outside by round-off, still
+/// finds one. Degenerate triangles are skipped; `corner_uv(i)` gives candidate i's corners. The
+/// coordinates are returned as computed (callers clamp them to the triangle); triangle -1 when no
+/// candidate is usable.
+template <typename CornerUv>
+MeshLocation deepest_triangle(const std::vector<int>& candidates, const CornerUv& corner_uv,
+                              const Eigen::Vector2d& p) {
+  MeshLocation best;
+  double best_min = -std::numeric_limits<double>::infinity();
+  for (size_t i = 0; i < candidates.size(); ++i) {
+    const Eigen::Vector3d b = barycentric_2d(corner_uv(i), p);
+    if (!b.isZero() && b.minCoeff() > best_min) {
+      best_min = b.minCoeff();
+      best = MeshLocation{candidates[i], b};
+    }
+  }
+  return best;
+}
 
 enum class Chart { Ptex, Texture };
 

@@ -362,21 +362,17 @@ struct FaceLocator {
     }
   }
 
-  // The triangle of ptex face `face` holding `uv` (the deepest inside, for a point on an edge),
-  // barycentric coordinates clamped to the triangle.
+  // The triangle of ptex face `face` holding `uv` (deepest_triangle), barycentric coordinates
+  // clamped to the triangle; triangle -1 when the face has none.
   MeshLocation locate(int face, const Eigen::Vector2d& uv) const {
-    MeshLocation at;
-    double deepest = -std::numeric_limits<double>::infinity();
-    for (const int t : face_triangles[static_cast<size_t>(face)]) {
-      const Eigen::Vector3d b = barycentric_2d(corner_uv[static_cast<size_t>(t)], uv);
-      if (b.minCoeff() > deepest) {
-        deepest = b.minCoeff();
-        at.triangle = t;
-        at.bary = b;
-      }
+    const std::vector<int>& candidates = face_triangles[static_cast<size_t>(face)];
+    MeshLocation at = deepest_triangle(
+        candidates,
+        [&](size_t i) -> const auto& { return corner_uv[static_cast<size_t>(candidates[i])]; }, uv);
+    if (at.triangle >= 0) {
+      at.bary = at.bary.cwiseMax(0.0);
+      at.bary /= at.bary.sum();
     }
-    at.bary = at.bary.cwiseMax(0.0);
-    at.bary /= at.bary.sum();
     return at;
   }
 };

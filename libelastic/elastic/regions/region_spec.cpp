@@ -42,25 +42,17 @@ const std::vector<std::array<Eigen::Vector2d, 3>>& RegionContext::corner_uv() co
 }
 
 MeshLocation RegionContext::locate(const SurfacePoint& p) const {
-  MeshLocation best;
-  double best_min = -std::numeric_limits<double>::infinity();
   // Before any whole-surface cut, only the point's face needs its triangles' corner (u, v).
   const std::vector<int>& candidates = face_triangles[static_cast<size_t>(p.face)];
   const std::vector<std::array<Eigen::Vector2d, 3>> uv =
       corner_uv_.empty() ? tessellation_corner_uv(surface, tess, candidates)
                          : std::vector<std::array<Eigen::Vector2d, 3>>{};
-  for (size_t i = 0; i < candidates.size(); ++i) {
-    const int t = candidates[i];
-    const Eigen::Vector3d b =
-        barycentric_2d(uv.empty() ? corner_uv_[static_cast<size_t>(t)] : uv[i], p.uv());
-    if (b.isZero()) {
-      continue;
-    }
-    if (b.minCoeff() > best_min) {
-      best_min = b.minCoeff();
-      best = MeshLocation{t, b};
-    }
-  }
+  MeshLocation best = deepest_triangle(
+      candidates,
+      [&](size_t i) -> const auto& {
+        return uv.empty() ? corner_uv_[static_cast<size_t>(candidates[i])] : uv[i];
+      },
+      p.uv());
   if (best.triangle < 0) {
     throw NumericalError(options.name, "internal: cannot locate a surface point");
   }
