@@ -350,12 +350,11 @@ int refinement_levels(const LimitTessellation& tess, const DiskNeighbourhood& pa
 // The tessellation triangles of each ptex face with their corners' (u, v), to locate a surface
 // point by its parameters.
 struct FaceLocator {
-  const LimitTessellation& tess;
   std::vector<std::array<Eigen::Vector2d, 3>> corner_uv;
   std::vector<std::vector<int>> face_triangles;
 
   FaceLocator(const LimitSurface& surface, const LimitTessellation& t)
-      : tess(t), corner_uv(tessellation_corner_uv(surface, t)) {
+      : corner_uv(tessellation_corner_uv(surface, t)) {
     face_triangles.resize(static_cast<size_t>(surface.num_faces()));
     for (size_t k = 0; k < t.triangles.size(); ++k) {
       face_triangles[static_cast<size_t>(t.triangle_face[k])].push_back(static_cast<int>(k));

@@ -129,7 +129,7 @@ class Sampler {
   std::vector<ClosestPoint> projected_;
   std::vector<double> new_s_, new_r_;
   std::vector<char> moving_;
-  std::vector<double> face_before_;  // accept_sequentially's faces around one particle
+  std::vector<double> face_before_;  // per face: accept_sequentially's smallest sine before a move
 
   // Newton step: per particle its first unknown (-1: held), its number of unknowns (2 interior,
   // 0 boundary) and tangent basis; the interior numbering of the preconditioner.
@@ -203,6 +203,7 @@ Sampler::Sampler(ParticleGrid& grid, const Region& region, const SurfaceProjecto
   new_s_.assign(np_, 0.0);
   new_r_.assign(np_, 0.0);
   moving_.assign(np_, 0);
+  face_before_.assign(static_cast<size_t>(faces_.nodes()), 1.0);
   targets_.resize(interior_.size());
   hints_.resize(interior_.size());
   projected_.resize(interior_.size());
@@ -355,20 +356,13 @@ double Sampler::accept_sequentially() {
     }
     const double before = min_sine_around(p);
     // The faces' own smallest sines, needed only around a turned-over face (move_acceptable).
-    face_before_.clear();
     if (!(before > 0.0)) {
       for (int k = vertex_faces_.start[p]; k < vertex_faces_.start[p + 1]; ++k) {
-        face_before_.push_back(face_min_sine(vertex_faces_.items[k]));
+        const int f = vertex_faces_.items[k];
+        face_before_[f] = face_min_sine(f);
       }
     }
-    const auto face_before = [&](int f) {
-      for (int k = vertex_faces_.start[p]; k < vertex_faces_.start[p + 1]; ++k) {
-        if (vertex_faces_.items[k] == f) {
-          return face_before_[k - vertex_faces_.start[p]];
-        }
-      }
-      return 1.0;
-    };
+    const auto face_before = [&](int f) { return face_before_[f]; };
     const Eigen::Vector3d old_x = x_[p], old_n = normal_[p];
     const double old_r = r_[p];
     const SurfacePoint old_sp = sp[p];
