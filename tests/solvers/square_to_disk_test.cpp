@@ -334,12 +334,28 @@ TEST(Untangle, RobustEnergyUntanglesThenConvergesOnTheGoblet) {
   fold_the_start(naive);
   RelaxationOptions options;
   options.angular_stiffness = 0.3;
+  // Line searches from the full step: the first run then stops against the unprotected sliver
+  // and the untangling phase is needed.
+  options.lbfgs.step_memory = false;
   const RelaxationResult result = relax(naive.problem, options);
   EXPECT_GT(result.initial_folded_faces, 0);
   EXPECT_EQ(result.untangle_phases, 1);
   EXPECT_TRUE(result.converged) << to_string(result.reason);
   EXPECT_EQ(result.folded_faces, 0);
   EXPECT_GT(smallest_stretch(naive.grid, result.positions, naive.problem.rest_scale), 0.0);
+  // From the last search's step (the default) the first run unfolds the start by itself, to the
+  // same minimum.
+  options.lbfgs.step_memory = true;
+  const RelaxationResult remembered = relax(naive.problem, options);
+  EXPECT_EQ(remembered.untangle_phases, 0);
+  EXPECT_TRUE(remembered.converged) << to_string(remembered.reason);
+  EXPECT_EQ(remembered.folded_faces, 0);
+  EXPECT_NEAR(remembered.length_energy + remembered.angular_energy,
+              result.length_energy + result.angular_energy,
+              1e-6 * (result.length_energy + result.angular_energy));
+  // Measured: 72 energy evaluations in 69 iterations, against 743 in 73 (ten halvings an
+  // iteration next to the barrier's sliver).
+  EXPECT_LT(remembered.evaluations, result.evaluations / 4);
 }
 
 }  // namespace

@@ -533,7 +533,10 @@ class LbfgsRun {
   // Backtracking line search along the retraction. True when a trial is accepted (the trial state
   // holds it).
   bool line_search() {
-    double alpha = first_step();
+    const double full = first_step();
+    // LbfgsOptions::step_memory: start where the last iteration's search ended, doubled.
+    double alpha =
+        lb_.step_memory && !memory_.empty() ? full * std::min(1.0, 2.0 * accepted_fraction_) : full;
     int backtracks = 0, block_rounds = 0, fold_halvings = 0;
     while (backtracks < lb_.max_backtracks && slope_ < 0.0) {
       trial_q_ready_ = false;
@@ -566,6 +569,7 @@ class LbfgsRun {
         continue;
       }
       if (acceptable(alpha)) {
+        accepted_fraction_ = alpha / full;
         return true;
       }
       alpha *= 0.5;
@@ -805,6 +809,7 @@ class LbfgsRun {
   // oldest pair's once the memory is full).
   Eigen::VectorXd direction_, solved_;
   double slope_ = 0.0;
+  double accepted_fraction_ = 1.0;  // the last accepted alpha over that search's full step
   std::deque<Pair> memory_;
   Pair next_;
 

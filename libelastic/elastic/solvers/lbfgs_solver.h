@@ -26,7 +26,9 @@
 ///    Gauss-Newton steps; where the parameterisation is degenerate, the walk reaches the surface
 ///    boundary or the correction fails, the magnet itself is used (warm started). See
 ///    solver_detail::parametric_retraction.
-/// 5. Backtracking line search from alpha = 1. A trial that folds a face corner that was not folded
+/// 5. Backtracking line search from alpha = 1, or with LbfgsOptions::step_memory (the default)
+///    from twice the fraction of its full step the previous iteration accepted (at most 1; 1
+///    after the memory is cleared). A trial that folds a face corner that was not folded
 ///    (SpringSystem::folded_corners with the new normals) is never taken. The first 4 such trials
 ///    halve alpha; after that the free particles of the newly folded corners are *held*: they keep
 ///    their position from then on, like boundary particles, and the solver continues in the
