@@ -219,6 +219,16 @@ TEST(SquareToDisk, RobustEnergyConvergesWithoutSlivers) {
   EXPECT_TRUE(result.converged) << to_string(result.reason);
   EXPECT_EQ(result.folded_faces, 0);
   EXPECT_TRUE(result.held_particles.empty());
+  // Every line search from the full step (LbfgsOptions::step_memory off) reaches the same minimum
+  // with more energy evaluations: the barrier at the opened corners makes the full step too long
+  // at every iteration. Measured: 142 evaluations in 77 iterations against 244 in 90.
+  RelaxationOptions from_full;
+  from_full.lbfgs.step_memory = false;
+  const RelaxationResult full = relax(naive.problem, from_full);
+  EXPECT_TRUE(full.converged) << to_string(full.reason);
+  const double energy = result.length_energy + result.angular_energy;
+  EXPECT_NEAR(energy, full.length_energy + full.angular_energy, 1e-6 * energy);
+  EXPECT_LT(result.evaluations, 3 * full.evaluations / 4);
   const double robust = smallest_stretch(naive.grid, result.positions, naive.problem.rest_scale);
   EXPECT_GE(robust, 0.2);
   RelaxationOptions paper;
@@ -334,8 +344,8 @@ TEST(Untangle, RobustEnergyUntanglesThenConvergesOnTheGoblet) {
   fold_the_start(naive);
   RelaxationOptions options;
   options.angular_stiffness = 0.3;
-  // Line searches from the full step: the first run then stops against the unprotected sliver
-  // and the untangling phase is needed.
+  // Every line search from the full step, as when this start was chosen: it is the untangling
+  // phase that is tested here, whatever the line search's first trial.
   options.lbfgs.step_memory = false;
   const RelaxationResult result = relax(naive.problem, options);
   EXPECT_GT(result.initial_folded_faces, 0);
@@ -343,19 +353,6 @@ TEST(Untangle, RobustEnergyUntanglesThenConvergesOnTheGoblet) {
   EXPECT_TRUE(result.converged) << to_string(result.reason);
   EXPECT_EQ(result.folded_faces, 0);
   EXPECT_GT(smallest_stretch(naive.grid, result.positions, naive.problem.rest_scale), 0.0);
-  // From the last search's step (the default) the first run unfolds the start by itself, to the
-  // same minimum.
-  options.lbfgs.step_memory = true;
-  const RelaxationResult remembered = relax(naive.problem, options);
-  EXPECT_EQ(remembered.untangle_phases, 0);
-  EXPECT_TRUE(remembered.converged) << to_string(remembered.reason);
-  EXPECT_EQ(remembered.folded_faces, 0);
-  EXPECT_NEAR(remembered.length_energy + remembered.angular_energy,
-              result.length_energy + result.angular_energy,
-              1e-6 * (result.length_energy + result.angular_energy));
-  // Measured: 72 energy evaluations in 69 iterations, against 743 in 73 (ten halvings an
-  // iteration next to the barrier's sliver).
-  EXPECT_LT(remembered.evaluations, result.evaluations / 4);
 }
 
 }  // namespace

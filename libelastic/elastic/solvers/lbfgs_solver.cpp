@@ -36,6 +36,13 @@ constexpr int kMaxReleases = 1;
 constexpr int kMaxStalled = 20;
 // Longest first trial step of a particle, in mean rest lengths (times sigma).
 constexpr double kMaxStep = 2.0;
+// LbfgsOptions::step_memory forgets a search that needed more than 8 halvings: such a search met an
+// obstacle (a trial that folds, a boundary particle reaching its neighbour), not a direction too
+// long by a steady factor, and starting the next ones from it made them crawl back by doubling
+// for 8 iterations or more, long enough to trip the slide's 20-iteration settle test (seed 17's
+// hand_lowres -> decimated-max map then stopped its slide early: length energy 187 against 165,
+// sigma_min 0.064 against 0.436).
+constexpr double kStepMemoryFloor = 1.0 / 256.0;
 
 // Vector kernels over [0, n) in fixed chunks. Reductions join the chunks' partial sums in a fixed
 // tree (parallel_deterministic_reduce), so every result is the same for any number of threads; at
@@ -535,8 +542,9 @@ class LbfgsRun {
   bool line_search() {
     const double full = first_step();
     // LbfgsOptions::step_memory: start where the last iteration's search ended, doubled.
-    double alpha =
-        lb_.step_memory && !memory_.empty() ? full * std::min(1.0, 2.0 * accepted_fraction_) : full;
+    double alpha = lb_.step_memory && !memory_.empty() && accepted_fraction_ >= kStepMemoryFloor
+                       ? full * std::min(1.0, 2.0 * accepted_fraction_)
+                       : full;
     int backtracks = 0, block_rounds = 0, fold_halvings = 0;
     while (backtracks < lb_.max_backtracks && slope_ < 0.0) {
       trial_q_ready_ = false;

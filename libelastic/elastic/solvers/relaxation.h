@@ -175,11 +175,12 @@ struct LbfgsOptions {
   /// The first trial of a line search: off, the full step (alpha = 1, or shorter when it would move
   /// a particle more than 2 rest lengths); on, that step times min(1, 2 f), f the fraction of its
   /// full step the previous iteration accepted (the full step again after the memory of pairs is
-  /// cleared, and whenever the last search took it whole). Where the injectivity barrier stiffens a
-  /// few thin triangles (a square's corners opened on a round boundary), the L^-1-based direction
-  /// was 10-20 times too long at every iteration: four halvings, five energy evaluations per
-  /// iteration. On the robustness benchmark: 37.9 s against 65.5 s in all, its slowest cases 3-4
-  /// times faster, every case still passing (docs/solvers.md).
+  /// cleared, when the last search took it whole, and when it took less than 1/256 of it). Where
+  /// the injectivity barrier stiffens a few thin triangles (a square's corners opened on a round
+  /// boundary), the L^-1-based direction was 10-20 times too long at every iteration: four
+  /// halvings, five energy evaluations per iteration. On the robustness benchmark: 39.2 s
+  /// against 65.5 s in all, its slowest cases 3-4 times faster, every case still passing
+  /// (docs/solvers.md).
   bool step_memory = true;
   NewtonOptions newton;  ///< when H0 is the energy's Hessian instead
 };
