@@ -159,6 +159,8 @@ struct NewtonOptions {
   /// edge, the star polygon onto spot's flank (length energy 5% lower, but sigma_min 0.200
   /// against the bar's 0.2, where the Laplacian H0's slide ends at 0.208). Held where the slide
   /// left it, the interior has one minimum, which the Newton H0 reaches in fewer iterations.
+  /// Measured again beside LbfgsOptions::step_memory (2026-12-07): the benchmark's iterations
+  /// 11,916 -> 7,947 but its seconds 37.9 -> 43.3, and that star polygon at sigma_min 0.1989.
   bool in_slide = false;
 };
 
