@@ -39,9 +39,8 @@ constexpr double kMaxStep = 2.0;
 // LbfgsOptions::step_memory forgets a search that needed more than 8 halvings: such a search met an
 // obstacle (a trial that folds, a boundary particle reaching its neighbour), not a direction too
 // long by a steady factor, and starting the next ones from it made them crawl back by doubling
-// for 8 iterations or more, long enough to trip the slide's 20-iteration settle test (seed 17's
-// hand_lowres -> decimated-max map then stopped its slide early: length energy 187 against 165,
-// sigma_min 0.064 against 0.436).
+// for 8 iterations or more, long enough to trip the slide's 20-iteration settle test
+// (docs/solvers.md has the case).
 constexpr double kStepMemoryFloor = 1.0 / 256.0;
 
 // Vector kernels over [0, n) in fixed chunks. Reductions join the chunks' partial sums in a fixed

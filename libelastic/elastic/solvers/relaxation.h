@@ -159,8 +159,7 @@ struct NewtonOptions {
   /// edge, the star polygon onto spot's flank (length energy 5% lower, but sigma_min 0.200
   /// against the bar's 0.2, where the Laplacian H0's slide ends at 0.208). Held where the slide
   /// left it, the interior has one minimum, which the Newton H0 reaches in fewer iterations.
-  /// Measured again beside LbfgsOptions::step_memory (2026-12-07): the benchmark's iterations
-  /// 11,916 -> 7,947 but its seconds 37.9 -> 43.3, and that star polygon at sigma_min 0.1989.
+  /// Still so beside LbfgsOptions::step_memory (docs/solvers.md).
   bool in_slide = false;
 };
 
@@ -177,12 +176,9 @@ struct LbfgsOptions {
   /// The first trial of a line search: off, the full step (alpha = 1, or shorter when it would move
   /// a particle more than 2 rest lengths); on, that step times min(1, 2 f), f the fraction of its
   /// full step the previous iteration accepted (the full step again after the memory of pairs is
-  /// cleared, when the last search took it whole, and when it took less than 1/256 of it). Where
-  /// the injectivity barrier stiffens a few thin triangles (a square's corners opened on a round
-  /// boundary), the L^-1-based direction was 10-20 times too long at every iteration: four
-  /// halvings, five energy evaluations per iteration. On the robustness benchmark: 39.2 s
-  /// against 65.5 s in all, its slowest cases 3-4 times faster, every case still passing
-  /// (docs/solvers.md).
+  /// cleared and after a search that took less than 1/256 of it). Where the injectivity barrier
+  /// stiffens a few thin triangles the L^-1-based direction is too long by a steady factor, and
+  /// every search from the full step halved it again; measurements in docs/solvers.md.
   bool step_memory = true;
   NewtonOptions newton;  ///< when H0 is the energy's Hessian instead
 };
