@@ -136,7 +136,8 @@ struct InteriorLayout {
 
 struct Pair {
   Eigen::VectorXd s, y;
-  double rho = 0.0;  // 1 / (s . y)
+  double rho = 0.0;    // 1 / (s . y)
+  double gamma = 0.0;  // s . y / (y . H0 y): H0's scale after this pair (LbfgsOptions::scale_h0)
 };
 
 // One call of relax_lbfgs: the state its iterations share and its steps (lbfgs_solver.h's list)
@@ -490,6 +491,11 @@ class LbfgsRun {
       axpy(-alphas[k], memory_[k].y, direction_);
     }
     apply_h0(direction_);
+    scaled_ = !memory_.empty() && memory_.back().gamma > 0.0 &&
+              energies_.barrier <= energies_.length + energies_.angular;
+    if (scaled_) {
+      direction_ *= memory_.back().gamma;  // LbfgsOptions::scale_h0
+    }
     for (std::size_t k = 0; k < memory_.size(); ++k) {
       const double beta = memory_[k].rho * dot(memory_[k].y, direction_);
       axpy(alphas[k] - beta, memory_[k].s, direction_);
@@ -511,6 +517,7 @@ class LbfgsRun {
   // rows.
   void preconditioned_gradient_direction() {
     memory_.clear();
+    scaled_ = false;
     direction_ = q_free_;
     apply_h0(direction_);
     direction_ = -direction_;
@@ -541,9 +548,10 @@ class LbfgsRun {
   bool line_search() {
     const double full = first_step();
     // LbfgsOptions::step_memory: start where the last iteration's search ended, doubled.
-    double alpha = lb_.step_memory && !memory_.empty() && accepted_fraction_ >= kStepMemoryFloor
-                       ? full * std::min(1.0, 2.0 * accepted_fraction_)
-                       : full;
+    double alpha =
+        lb_.step_memory && !scaled_ && !memory_.empty() && accepted_fraction_ >= kStepMemoryFloor
+            ? full * std::min(1.0, 2.0 * accepted_fraction_)
+            : full;
     int backtracks = 0, block_rounds = 0, fold_halvings = 0;
     while (backtracks < lb_.max_backtracks && slope_ < 0.0) {
       trial_q_ready_ = false;
@@ -763,6 +771,13 @@ class LbfgsRun {
     const double sy = dot(next_.s, next_.y);
     if (sy > 1e-12 * std::sqrt(dot(next_.s, next_.s) * dot(next_.y, next_.y)) && lb_.memory > 0) {
       next_.rho = 1.0 / sy;
+      next_.gamma = 0.0;
+      if (lb_.scale_h0 && !setup_.slide && !newton_on_) {
+        direction_ = next_.y;  // scratch: the next direction starts again from q_free
+        apply_h0(direction_);
+        const double yhy = dot(next_.y, direction_);
+        next_.gamma = yhy > 0.0 && std::isfinite(yhy) ? sy / yhy : 0.0;
+      }
       memory_.push_back(std::move(next_));
       next_ = Pair{};
       if (memory_.size() > static_cast<std::size_t>(lb_.memory)) {
@@ -817,6 +832,7 @@ class LbfgsRun {
   Eigen::VectorXd direction_, solved_;
   double slope_ = 0.0;
   double accepted_fraction_ = 1.0;  // the last accepted alpha over that search's full step
+  bool scaled_ = false;             // this iteration's H0 is scaled (LbfgsOptions::scale_h0)
   std::deque<Pair> memory_;
   Pair next_;
 

@@ -14,7 +14,9 @@
 ///    Gram matrices), applied to the x, y and z coordinates by one algebraic-multigrid V-cycle
 ///    (multigrid.h, default) or an exact sparse LDL^T in nested-dissection order
 ///    (LbfgsOptions::preconditioner). The first step is therefore (about) the Laplacian solve
-///    -L^-1 P g, a Newton step for the springs linearised at rest.
+///    -L^-1 P g, a Newton step for the springs linearised at rest. After that H0 = gamma L^-1,
+///    gamma = s.y / (y.L^-1 y) of the newest pair (LbfgsOptions::scale_h0: not in the slide of a
+///    sliding boundary, nor while the barrier's energy is above the springs').
 /// 3. p is projected on the tangent planes again. If it is not a descent direction (P g . p >= 0)
 ///    the memory is cleared and p = -P L^-1 P g is used.
 /// 4. Retraction: the tangent step t_i = alpha p_i is pulled back to the parameter plane of the
@@ -26,11 +28,11 @@
 ///    Gauss-Newton steps; where the parameterisation is degenerate, the walk reaches the surface
 ///    boundary or the correction fails, the magnet itself is used (warm started). See
 ///    solver_detail::parametric_retraction.
-/// 5. Backtracking line search from alpha = 1, or with LbfgsOptions::step_memory (the default)
-///    from twice the fraction of its full step the previous iteration accepted (at most 1; 1
-///    after the memory is cleared or when that fraction was below 1/256). A trial that folds a face
-///    corner that was not folded (SpringSystem::folded_corners with the new normals) is never
-///    taken. The first 4 such trials halve alpha; after that the free particles of the newly folded
+/// 5. Backtracking line search from alpha = 1, or with LbfgsOptions::step_memory (the default,
+///    where H0 is not scaled) from twice the fraction of its full step the previous iteration
+///    accepted (at most 1; 1 after the memory is cleared or when that fraction was below 1/256).
+///    A trial that folds a face corner that was not folded (SpringSystem::folded_corners with
+///    the new normals) is never taken. The first 4 such trials halve alpha; after that the free particles of the newly folded
 ///    corners are *held*: they keep their position from then on, like boundary particles, and the
 ///    solver continues in the subspace of the others (their rows of P g, of L^-1 and of p are zero;
 ///    the memory is cleared and p recomputed as -P L^-1 P g on the new subspace), retrying the same

@@ -180,6 +180,16 @@ struct LbfgsOptions {
   /// stiffens a few thin triangles the L^-1-based direction is too long by a steady factor, and
   /// every search from the full step halved it again; measurements in docs/solvers.md.
   bool step_memory = true;
+  /// H0 times gamma = s.y / (y.H0 y) of the newest pair (Nocedal and Wright's scaling, eq. 7.20,
+  /// with H0 in place of the identity), outside a sliding boundary's slide and with the Laplacian
+  /// H0 only, while the barrier's energy is at most the springs' (E_len + E_ang). L^-1 knows
+  /// nothing of the barrier's stiffness: where it holds thin triangles open, gamma is 0.01-0.1 and
+  /// the unscaled direction was as many times too long at every iteration. Far from the barrier's
+  /// minimum its stiffest triangles set gamma (1e-13 on the star polygon's start) and the scaled H0
+  /// crawls, and in the slide it slowed the boundary's long-range motion until the settle test
+  /// stopped it early: unscaled there. One more H0 application per iteration; measurements in
+  /// docs/solvers.md.
+  bool scale_h0 = true;
   NewtonOptions newton;  ///< when H0 is the energy's Hessian instead
 };
 
