@@ -120,6 +120,26 @@ TEST(SpringEnergy, BarrierGradientMatchesFiniteDifferences) {
   EXPECT_GE(tested, 2);
 }
 
+// evaluate_springs of the robust system: the energies and gradient of a system without the
+// triangle terms, to the bit, while the system's own evaluate() includes the barrier.
+TEST(SpringEnergy, SpringsAloneEqualASystemWithoutTriangleTerms) {
+  const ParticleGrid grid = test::make_quad_grid(4, 3, 1.0);
+  const SpringSystem system(grid, barrier_test_options(true));
+  const SpringSystem springs_only(grid, barrier_test_options(false));
+  Eigen::Matrix3Xd x = random_configuration(grid, 0.3, 3);
+  x.row(2).setZero();
+  Eigen::Matrix3Xd alone, reference, full;
+  const SpringEnergies e = system.evaluate_springs(x, &alone);
+  const SpringEnergies r = springs_only.evaluate(x, &reference);
+  ASSERT_GT(system.evaluate(x, &full).barrier, 0.0);
+  EXPECT_EQ(e.length, r.length);
+  EXPECT_EQ(e.angular, r.angular);
+  EXPECT_EQ(e.barrier, 0.0);
+  EXPECT_TRUE((alone.array() == reference.array()).all());
+  EXPECT_GT((full - alone).norm(), 0.0);
+  EXPECT_EQ(system.evaluate_springs(x).length, r.length);
+}
+
 // The terms over grid triangles (E_bar + E_sd) at x seen along `normals`: their gradient, normals
 // held fixed, against central differences in x, and dE/dn against central differences in the unit
 // normals (each perturbed normal normalised again): those see dE/dn's part orthogonal to n, the

@@ -192,14 +192,24 @@ void SpringSystem::build_barrier(const ParticleGrid& grid) {
     const auto& q = grid.mesh.point(GridMesh::VertexHandle(p));
     return Eigen::Vector3d(q[0], q[1], q[2]);
   };
-  // Corners of one face are consecutive in corners_.
-  for (std::size_t first = 0; first < corners_.size();) {
-    std::size_t end = first;
-    while (end < corners_.size() && corners_[end].face == corners_[first].face) {
-      ++end;
+  // Corners of one face are consecutive in corners_: body(first, count) for each face.
+  const auto each_face = [&](const auto& body) {
+    for (std::size_t first = 0; first < corners_.size();) {
+      std::size_t end = first;
+      while (end < corners_.size() && corners_[end].face == corners_[first].face) {
+        ++end;
+      }
+      body(first, end - first);
+      first = end;
     }
-    const std::size_t k = end - first;
-    // A triangle once (weight 1); a quad by the four corner triangles of its two splits (1/2).
+  };
+  // A triangle once (weight 1); a quad by the four corner triangles of its two splits (1/2).
+  // Counted first and reserved exactly: the triangles (48 bytes each, four per particle of a quad
+  // grid) take no spare capacity.
+  std::size_t triangles = 0;
+  each_face([&](std::size_t, std::size_t k) { triangles += k == 3 ? 1 : k; });
+  barrier_.reserve(triangles);
+  each_face([&](std::size_t first, std::size_t k) {
     const std::size_t count = k == 3 ? 1 : k;
     const double weight = k == 3 ? 1.0 : 2.0 / static_cast<double>(k);
     for (std::size_t c = first; c < first + count; ++c) {
@@ -225,8 +235,7 @@ void SpringSystem::build_barrier(const ParticleGrid& grid) {
       t.source_det = det;
       barrier_.push_back(t);
     }
-    first = end;
-  }
+  });
   barrier_active_.assign(barrier_.size(), 1);
   std::vector<std::pair<int, int>> pairs;
   pairs.reserve(3 * barrier_.size());
@@ -282,6 +291,21 @@ SpringEnergies SpringSystem::evaluate(const Eigen::Matrix3Xd& x, Eigen::Matrix3X
     } else {
       normal_gradient->setZero(3, num_particles_);
     }
+  }
+  return energies;
+}
+
+SpringEnergies SpringSystem::evaluate_springs(const Eigen::Matrix3Xd& x,
+                                              Eigen::Matrix3Xd* gradient) const {
+  if (x.cols() != num_particles_) {
+    throw InvalidInputError("particle positions", "expected " + std::to_string(num_particles_) +
+                                                      " columns, got " + std::to_string(x.cols()));
+  }
+  SpringEnergies energies;
+  energies.length = length_energy(x, gradient != nullptr);
+  energies.angular = angular_energy(x, gradient != nullptr);
+  if (gradient != nullptr) {
+    gather_gradient(false, *gradient);
   }
   return energies;
 }

@@ -76,13 +76,18 @@ double sum_chunks(Eigen::Index n, const Term& term) {
       std::plus<double>());
 }
 
-double dot(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
-  return sum_chunks(a.size(), [&](Eigen::Index i) { return a[i] * b[i]; });
+// In double precision whatever the vectors' own (the memory's pairs are stored in single).
+template <typename A, typename B>
+double dot(const A& a, const B& b) {
+  return sum_chunks(a.size(), [&](Eigen::Index i) {
+    return static_cast<double>(a[i]) * static_cast<double>(b[i]);
+  });
 }
 
 // y += alpha x
-void axpy(double alpha, const Eigen::VectorXd& x, Eigen::VectorXd& y) {
-  for_chunks(x.size(), [&](Eigen::Index i) { y[i] += alpha * x[i]; });
+template <typename X>
+void axpy(double alpha, const X& x, Eigen::VectorXd& y) {
+  for_chunks(x.size(), [&](Eigen::Index i) { y[i] += alpha * static_cast<double>(x[i]); });
 }
 
 // Interior vectors have 3n entries laid out as an n x 3 column-major matrix (all x, then all y,
@@ -134,8 +139,11 @@ struct InteriorLayout {
   }
 };
 
+// s and y in single precision: 8 pairs of 3n doubles were 384 MB of a million-particle map's
+// peak; the two-loop recursion computes in double with the stored values (rho too, so each pair
+// stays consistent), and a pair only shapes the direction, which the line search checks.
 struct Pair {
-  Eigen::VectorXd s, y;
+  Eigen::VectorXf s, y;
   double rho = 0.0;    // 1 / (s . y)
   double gamma = 0.0;  // s . y / (y . H0 y): H0's scale after this pair (LbfgsOptions::scale_h0)
 };
@@ -764,8 +772,9 @@ class LbfgsRun {
       const auto p = static_cast<Eigen::Index>(setup_.interior[static_cast<std::size_t>(k)]);
       const bool free = !held_[static_cast<std::size_t>(k)];
       for (int c = 0; c < 3; ++c) {
-        next_.s[c * n_ + k] = trial_positions_(c, p) - setup_.positions(c, p);
-        next_.y[c * n_ + k] = free ? trial_q_[c * n_ + k] - q_free_[c * n_ + k] : 0.0;
+        next_.s[c * n_ + k] = static_cast<float>(trial_positions_(c, p) - setup_.positions(c, p));
+        next_.y[c * n_ + k] =
+            free ? static_cast<float>(trial_q_[c * n_ + k] - q_free_[c * n_ + k]) : 0.0F;
       }
     });
     const double sy = dot(next_.s, next_.y);
@@ -773,7 +782,8 @@ class LbfgsRun {
       next_.rho = 1.0 / sy;
       next_.gamma = 0.0;
       if (lb_.scale_h0 && !setup_.slide && !newton_on_) {
-        direction_ = next_.y;  // scratch: the next direction starts again from q_free
+        direction_ =
+            next_.y.cast<double>();  // scratch: the next direction starts again from q_free
         apply_h0(direction_);
         const double yhy = dot(next_.y, direction_);
         next_.gamma = yhy > 0.0 && std::isfinite(yhy) ? sy / yhy : 0.0;

@@ -287,11 +287,8 @@ void add_normal_motion(const RelaxationSetup& setup, const Eigen::Matrix3Xd& nor
 }
 
 double spring_gradient_norm(const RelaxationSetup& setup) {
-  SpringEnergyOptions paper = setup.springs.options();
-  paper.barrier_stiffness = 0.0;
-  paper.distortion_stiffness = 0.0;
   Eigen::Matrix3Xd gradient;
-  SpringSystem(setup.grid, paper).evaluate(setup.positions, &gradient);
+  setup.springs.evaluate_springs(setup.positions, &gradient);
   return tangential_norm(setup, gradient, setup.normals);
 }
 
