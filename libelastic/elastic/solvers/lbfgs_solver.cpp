@@ -182,6 +182,7 @@ class LbfgsRun {
     }
     result_.iterations = iteration_;
     result_.solve_seconds = solver_detail::seconds_since(solve_start);
+    release_buffers();
     solver_detail::finish_result(setup_, problem_, initial_norm_, result_);
     return std::move(result_);
   }
@@ -234,6 +235,26 @@ class LbfgsRun {
     initial_norm_ = problem_.reference_gradient_norm > 0.0 ? problem_.reference_gradient_norm
                     : spring_norm > 0.0                    ? spring_norm
                                                            : q_norm_;
+  }
+
+  // The iterations' buffers go before the final measurements, which evaluate the energy and its
+  // gradient once more: at a million particles the pairs, trial state and frames are about 0.7 GB,
+  // and with them live that evaluation set the map's peak.
+  void release_buffers() {
+    memory_.clear();
+    next_ = Pair{};
+    laplacian_.reset();
+    newton_.reset();
+    for (Eigen::VectorXd* v : {&q_, &q_free_, &direction_, &solved_, &trial_q_}) {
+      *v = Eigen::VectorXd();
+    }
+    for (Eigen::Matrix3Xd* m :
+         {&gradient_, &normal_gradient_, &trial_positions_, &trial_normals_, &trial_gradient_}) {
+      *m = Eigen::Matrix3Xd();
+    }
+    std::vector<SurfacePoint>().swap(trial_points_);
+    std::vector<SurfaceDerivatives>().swap(frames_);
+    std::vector<SurfaceDerivatives>().swap(trial_frames_);
   }
 
   // Round-off of an energy evaluation. Each term C (|d| - k)^2 carries an error of about

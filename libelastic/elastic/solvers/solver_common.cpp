@@ -292,14 +292,12 @@ double spring_gradient_norm(const RelaxationSetup& setup) {
   return tangential_norm(setup, gradient, setup.normals);
 }
 
-void finish_result(const RelaxationSetup& setup, const RelaxationProblem& problem,
+void finish_result(RelaxationSetup& setup, const RelaxationProblem& problem,
                    double initial_gradient_norm, RelaxationResult& result) {
   Eigen::Matrix3Xd gradient, normal_gradient;
   const SpringEnergies energies =
       setup.springs.evaluate(setup.positions, &gradient, &setup.normals, &normal_gradient);
   add_normal_motion(setup, normal_gradient, nullptr, gradient);
-  result.positions = setup.positions;
-  result.points = setup.points;
   result.length_energy = energies.length;
   result.angular_energy = energies.angular;
   result.barrier_energy = energies.barrier;
@@ -342,6 +340,8 @@ void finish_result(const RelaxationSetup& setup, const RelaxationProblem& proble
   result.rest_scale = problem.rest_scale;
   result.rest_scale_mode = problem.rest_scale_mode;
   result.converged = is_converged(result.reason);
+  result.positions = std::move(setup.positions);  // moved, not copied: the setup is done with them
+  result.points = std::move(setup.points);
 }
 
 const std::vector<double>& boundary_start(const RelaxationProblem& problem) {

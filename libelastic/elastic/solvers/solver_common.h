@@ -81,8 +81,8 @@ double spring_gradient_norm(const RelaxationSetup& setup);
 
 /// Fills the final measurements of `result` from the setup's current positions, points and normals:
 /// energies, tangential gradient (relative to `initial_gradient_norm`), folds, boundary residual,
-/// rest scale.
-void finish_result(const RelaxationSetup& setup, const RelaxationProblem& problem,
+/// rest scale; then moves the positions and points into it (the setup's are left empty).
+void finish_result(RelaxationSetup& setup, const RelaxationProblem& problem,
                    double initial_gradient_norm, RelaxationResult& result);
 
 /// The largest distance between a boundary particle and its target position
