@@ -24,8 +24,11 @@ Eigen::Matrix3Xd random_configuration(const ParticleGrid& grid, double amplitude
   std::mt19937 rng(seed);
   std::uniform_real_distribution<double> jitter(-amplitude, amplitude);
   Eigen::Matrix3Xd x = test::grid_positions(grid);
-  for (Eigen::Index p = 0; p < x.cols(); ++p)
-    for (int c = 0; c < 3; ++c) x(c, p) += jitter(rng);
+  for (Eigen::Index p = 0; p < x.cols(); ++p) {
+    for (int c = 0; c < 3; ++c) {
+      x(c, p) += jitter(rng);
+    }
+  }
   return x;
 }
 
@@ -33,13 +36,14 @@ Eigen::Matrix3Xd random_configuration(const ParticleGrid& grid, double amplitude
 template <typename Energy>
 Eigen::Matrix3Xd central_differences(const Eigen::Matrix3Xd& x, double h, Energy energy) {
   Eigen::Matrix3Xd g(3, x.cols());
-  for (Eigen::Index p = 0; p < x.cols(); ++p)
+  for (Eigen::Index p = 0; p < x.cols(); ++p) {
     for (int c = 0; c < 3; ++c) {
       Eigen::Matrix3Xd plus = x, minus = x;
       plus(c, p) += h;
       minus(c, p) -= h;
       g(c, p) = (energy(plus) - energy(minus)) / (2.0 * h);
     }
+  }
   return g;
 }
 
@@ -477,8 +481,9 @@ TEST(SpringEnergy, ForcesConserveLinearAndAngularMomentum) {
   Eigen::Matrix3Xd gradient;
   system.evaluate(x, &gradient);
   Eigen::Vector3d torque = Eigen::Vector3d::Zero();
-  for (Eigen::Index p = 0; p < x.cols(); ++p)
+  for (Eigen::Index p = 0; p < x.cols(); ++p) {
     torque += Eigen::Vector3d(x.col(p)).cross(Eigen::Vector3d(gradient.col(p)));
+  }
   // Round-off of sums of O(1) terms.
   EXPECT_LT(gradient.rowwise().sum().norm(), 1e-12 * gradient.norm());
   EXPECT_LT(torque.norm(), 1e-12 * gradient.norm() * x.norm());
@@ -536,8 +541,9 @@ TEST(SpringEnergy, MagnetGradientMatchesFiniteDifferences) {
   std::mt19937 rng(3);
   std::uniform_real_distribution<double> coordinate(-1.5, 1.5);
   Eigen::Matrix3Xd x(3, 6);
-  for (Eigen::Index p = 0; p < x.cols(); ++p)
+  for (Eigen::Index p = 0; p < x.cols(); ++p) {
     x.col(p) = Eigen::Vector3d(coordinate(rng), coordinate(rng), coordinate(rng));
+  }
   const auto sphere_closest = [](const Eigen::Matrix3Xd& y) {
     return Eigen::Matrix3Xd(y.colwise().normalized());
   };
