@@ -32,17 +32,19 @@
 ///    where H0 is not scaled) from twice the fraction of its full step the previous iteration
 ///    accepted (at most 1; 1 after the memory is cleared or when that fraction was below 1/256).
 ///    A trial that folds a face corner that was not folded (SpringSystem::folded_corners with
-///    the new normals) is never taken. The first 4 such trials halve alpha; after that the free particles of the newly folded
-///    corners are *held*: they keep their position from then on, like boundary particles, and the
-///    solver continues in the subspace of the others (their rows of P g, of L^-1 and of p are zero;
-///    the memory is cleared and p recomputed as -P L^-1 P g on the new subspace), retrying the same
-///    alpha, up to 8 rounds, after which alpha is halved again. A trial is also rejected (alpha
+///    the new normals) is never taken. The first 4 such trials halve alpha; after that the free
+///    particles of the newly folded corners are *held*: they keep their position from then on,
+///    like boundary particles, and the solver continues in the subspace of the others (their rows
+///    of P g, of L^-1 and of p are zero; the memory is cleared and p recomputed as -P L^-1 P g on
+///    the new subspace), retrying the same alpha, up to 8 rounds, after which alpha is halved
+///    again. A trial is also rejected (alpha
 ///    halved) when the energy is not finite or the Armijo condition E(alpha) <= E + c1 alpha (P g .
 ///    p) fails. Close to the minimum the energy change can drop below its round-off; a trial within
 ///    the energy's round-off (max(1e-13 E, 8 eps (1 + extent / mean rest) sqrt(E sum C k^2)), which
 ///    falls only like sqrt(E) near a perfect map) is then accepted when its tangential gradient is
 ///    smaller.
-/// 6. The pair (s, y) is kept when s . y > 1e-12 |s| |y| (curvature condition).
+/// 6. The pair (s, y) is kept when s . y > 1e-12 |s| |y| (curvature condition), stored in single
+///    precision (the recursion computes in double).
 ///
 /// 7. The Newton H0 (LbfgsOptions::newton, newton_preconditioner.h): in the default
 /// NewtonMode::Auto,
