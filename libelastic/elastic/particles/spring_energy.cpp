@@ -246,8 +246,6 @@ void SpringSystem::build_barrier(const ParticleGrid& grid) {
     pairs.emplace_back(barrier_[t].prev, code + 2);
   }
   build_incidence(num_particles_, pairs, barrier_offset_, barrier_entry_);
-  barrier_force_.resize(3, 2 * static_cast<Eigen::Index>(barrier_.size()));
-  barrier_normal_force_.resize(3, static_cast<Eigen::Index>(barrier_.size()));
 }
 
 int SpringSystem::set_barrier_mask(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& normals) {
@@ -381,106 +379,143 @@ double SpringSystem::angular_energy(const Eigen::Matrix3Xd& x, bool want_gradien
 //   dD/dT0 = 2 T1 x m,              dD/dT1 = 2 m x T0.
 // A collapsed (or, with normals, inverted) target triangle has infinite energy: the line search
 // backs off.
+// One barrier triangle's terms at x (see the header's energies): E_bar, E_sd, and with
+// `gradient` dE/dx_next, dE/dx_prev (corner i's is minus their sum) and dE/dn of its corners.
+SpringSystem::TriangleTerms SpringSystem::triangle_terms(std::size_t t, const Eigen::Matrix3Xd& x,
+                                                         const Eigen::Matrix3Xd* normals,
+                                                         bool gradient) const {
+  TriangleTerms out;
+  if (!barrier_active_[t]) {
+    return out;
+  }
+  const double mu = options_.barrier_stiffness * options_.stiffness;
+  const double sigma = options_.rest_scale;
+  const double g0 = 1.0 / (options_.barrier_sigma * options_.barrier_sigma);
+  const double lambda = options_.distortion_stiffness * options_.stiffness;
+  const BarrierTriangle& b = barrier_[t];
+  const Eigen::Vector3d t0 = x.col(b.next) - x.col(b.i);
+  const Eigen::Vector3d t1 = x.col(b.prev) - x.col(b.i);
+  const Eigen::Vector3d c = t0.cross(t1);
+  Eigen::Vector3d m = c;
+  Eigen::Vector3d u = Eigen::Vector3d::Zero();  // unit sum of the corner normals
+  double seen = 0.0, sum_norm = 0.0;            // c . u and |n_i + n_next + n_prev|
+  if (normals != nullptr) {
+    const Eigen::Vector3d s = normals->col(b.i) + normals->col(b.next) + normals->col(b.prev);
+    sum_norm = s.norm();
+    if (sum_norm > 0.0) {
+      u = s / sum_norm;
+      seen = c.dot(u);
+    }
+    if (!(seen > 0.0)) {  // also |s| = 0 (opposed normals) and NaN
+      out.barrier = std::numeric_limits<double>::infinity();
+      return out;
+    }
+    m = seen * u;
+  }
+  const double D = m.squaredNorm();
+  if (!(D > 0.0)) {
+    out.barrier = std::numeric_limits<double>::infinity();
+    return out;
+  }
+  const double a = b.b00 * t0.squaredNorm() + 2.0 * b.b01 * t0.dot(t1) + b.b11 * t1.squaredNorm();
+  const double q = sigma * sigma * b.source_det;
+  const double g = q * a / D;
+  // dE/da and dE/dD of each term; the barrier's (dh = dE/dg q: dE/da = dh / D, dE/dD =
+  // -dh a / D^2) in the form the barrier had alone, so its bits do not depend on E_sd.
+  double dh = 0.0, sd_da = 0.0, sd_dd = 0.0;
+  if (g > g0) {
+    const double r = g / g0 - 1.0;
+    out.barrier = mu * b.weight * r * r * r;
+    dh = mu * b.weight * 3.0 * r * r / g0 * q;
+  }
+  if (lambda > 0.0) {
+    // E_sd: lambda w (a / sigma^2 + g - 4), dg/da = q / D, dg/dD = -g / D.
+    out.distortion = lambda * b.weight * (a / (sigma * sigma) + g - 4.0);
+    sd_da = lambda * b.weight * (1.0 / (sigma * sigma) + q / D);
+    sd_dd = -lambda * b.weight * g / D;
+  }
+  out.has_gradient = dh != 0.0 || sd_da != 0.0 || sd_dd != 0.0;
+  if (!gradient || !out.has_gradient) {
+    return out;
+  }
+  const double over_d = 1.0 / D, a_over_d2 = a / (D * D);
+  const Eigen::Vector3d da0 = 2.0 * (b.b00 * t0 + b.b01 * t1);             // da/dT0
+  const Eigen::Vector3d da1 = 2.0 * (b.b11 * t1 + b.b01 * t0);             // da/dT1
+  const Eigen::Vector3d dd0 = 2.0 * t1.cross(m), dd1 = 2.0 * m.cross(t0);  // dD/dT0, dD/dT1
+  double de_dd = 0.0;
+  if (dh != 0.0) {
+    out.f0 = dh * (over_d * da0 - a_over_d2 * dd0);
+    out.f1 = dh * (over_d * da1 - a_over_d2 * dd1);
+    de_dd = -dh * a_over_d2;
+  }
+  if (lambda > 0.0) {
+    out.f0 += sd_da * da0 + sd_dd * dd0;
+    out.f1 += sd_da * da1 + sd_dd * dd1;
+    de_dd += sd_dd;
+  }
+  if (normals != nullptr) {
+    // dE/dn_j for each corner j: with s = n_i + n_next + n_prev, u = s / |s| and
+    // D = (c . u)^2, dD/dn_j = dD/ds = 2 (c . u) (I - u u^T) c / |s|.
+    out.fn = (2.0 * de_dd * seen / sum_norm) * (c - seen * u);
+  }
+  return out;
+}
+
+// The energies in a deterministic reduce; with the gradient, the triangles whose terms have one
+// get a slot (in triangle order) and their forces are computed again into it, in parallel. Most
+// triangles of a map sit below the barrier's threshold: dense force buffers were 72 bytes a
+// triangle, 290 MB at a million particles, rewritten at every evaluation.
 Eigen::Vector2d SpringSystem::triangle_energy(const Eigen::Matrix3Xd& x,
                                               const Eigen::Matrix3Xd* normals,
                                               bool want_gradient) const {
-  const double mu = options_.barrier_stiffness * options_.stiffness;
-  const double sigma = options_.rest_scale;
   if (normals != nullptr && normals->cols() != num_particles_) {
     throw InvalidInputError("particle normals", "expected " + std::to_string(num_particles_) +
                                                     " columns, got " +
                                                     std::to_string(normals->cols()));
   }
-  const double g0 = 1.0 / (options_.barrier_sigma * options_.barrier_sigma);
-  const double lambda = options_.distortion_stiffness * options_.stiffness;
-  return tbb::parallel_deterministic_reduce(
+  if (want_gradient) {
+    barrier_slot_.resize(barrier_.size());
+  }
+  const Eigen::Vector2d energies = tbb::parallel_deterministic_reduce(
       tbb::blocked_range<std::size_t>(0, barrier_.size(), kGrain), Eigen::Vector2d(0.0, 0.0),
       [&](const tbb::blocked_range<std::size_t>& range, Eigen::Vector2d sum) {
         for (std::size_t t = range.begin(); t != range.end(); ++t) {
-          const BarrierTriangle& b = barrier_[t];
-          const auto col = 2 * static_cast<Eigen::Index>(t);
+          const TriangleTerms terms = triangle_terms(t, x, normals, false);
+          sum[0] += terms.barrier;
+          sum[1] += terms.distortion;
           if (want_gradient) {
-            barrier_force_.middleCols<2>(col).setZero();
-            barrier_normal_force_.col(static_cast<Eigen::Index>(t)).setZero();
-          }
-          if (!barrier_active_[t]) {
-            continue;
-          }
-          const Eigen::Vector3d t0 = x.col(b.next) - x.col(b.i);
-          const Eigen::Vector3d t1 = x.col(b.prev) - x.col(b.i);
-          const Eigen::Vector3d c = t0.cross(t1);
-          Eigen::Vector3d m = c;
-          Eigen::Vector3d u = Eigen::Vector3d::Zero();  // unit sum of the corner normals
-          double seen = 0.0, sum_norm = 0.0;            // c . u and |n_i + n_next + n_prev|
-          if (normals != nullptr) {
-            const Eigen::Vector3d s =
-                normals->col(b.i) + normals->col(b.next) + normals->col(b.prev);
-            sum_norm = s.norm();
-            if (sum_norm > 0.0) {
-              u = s / sum_norm;
-              seen = c.dot(u);
-            }
-            if (!(seen > 0.0)) {  // also |s| = 0 (opposed normals) and NaN
-              sum[0] += std::numeric_limits<double>::infinity();
-              continue;
-            }
-            m = seen * u;
-          }
-          const double D = m.squaredNorm();
-          if (!(D > 0.0)) {
-            sum[0] += std::numeric_limits<double>::infinity();
-            continue;
-          }
-          const double a =
-              b.b00 * t0.squaredNorm() + 2.0 * b.b01 * t0.dot(t1) + b.b11 * t1.squaredNorm();
-          const double q = sigma * sigma * b.source_det;
-          const double g = q * a / D;
-          // dE/da and dE/dD of each term; the barrier's (dh = dE/dg q: dE/da = dh / D, dE/dD =
-          // -dh a / D^2) in the form the barrier had alone, so its bits do not depend on E_sd.
-          double dh = 0.0, sd_da = 0.0, sd_dd = 0.0;
-          if (g > g0) {
-            const double r = g / g0 - 1.0;
-            sum[0] += mu * b.weight * r * r * r;
-            dh = mu * b.weight * 3.0 * r * r / g0 * q;
-          }
-          if (lambda > 0.0) {
-            // E_sd: lambda w (a / sigma^2 + g - 4), dg/da = q / D, dg/dD = -g / D.
-            sum[1] += lambda * b.weight * (a / (sigma * sigma) + g - 4.0);
-            sd_da = lambda * b.weight * (1.0 / (sigma * sigma) + q / D);
-            sd_dd = -lambda * b.weight * g / D;
-          }
-          if (!want_gradient || (dh == 0.0 && sd_da == 0.0 && sd_dd == 0.0)) {
-            continue;
-          }
-          const double over_d = 1.0 / D, a_over_d2 = a / (D * D);
-          const Eigen::Vector3d da0 = 2.0 * (b.b00 * t0 + b.b01 * t1);             // da/dT0
-          const Eigen::Vector3d da1 = 2.0 * (b.b11 * t1 + b.b01 * t0);             // da/dT1
-          const Eigen::Vector3d dd0 = 2.0 * t1.cross(m), dd1 = 2.0 * m.cross(t0);  // dD/dT0, dD/dT1
-          // dE/dx_next and dE/dx_prev
-          Eigen::Vector3d f0 = Eigen::Vector3d::Zero(), f1 = Eigen::Vector3d::Zero();
-          double de_dd = 0.0;
-          if (dh != 0.0) {
-            f0 = dh * (over_d * da0 - a_over_d2 * dd0);
-            f1 = dh * (over_d * da1 - a_over_d2 * dd1);
-            de_dd = -dh * a_over_d2;
-          }
-          if (lambda > 0.0) {
-            f0 += sd_da * da0 + sd_dd * dd0;
-            f1 += sd_da * da1 + sd_dd * dd1;
-            de_dd += sd_dd;
-          }
-          barrier_force_.col(col) = f0;  // corner i's, -(f0 + f1), is formed where it is gathered
-          barrier_force_.col(col + 1) = f1;
-          if (normals != nullptr) {
-            // dE/dn_j for each corner j: with s = n_i + n_next + n_prev, u = s / |s| and
-            // D = (c . u)^2, dD/dn_j = dD/ds = 2 (c . u) (I - u u^T) c / |s|.
-            barrier_normal_force_.col(static_cast<Eigen::Index>(t)) =
-                (2.0 * de_dd * seen / sum_norm) * (c - seen * u);
+            barrier_slot_[t] = terms.has_gradient && std::isfinite(terms.barrier) ? 0 : -1;
           }
         }
         return sum;
       },
       std::plus<Eigen::Vector2d>());
+  if (!want_gradient) {
+    return energies;
+  }
+  std::vector<std::size_t> slotted;
+  for (std::size_t t = 0; t < barrier_.size(); ++t) {
+    if (barrier_slot_[t] == 0) {
+      barrier_slot_[t] = static_cast<int>(slotted.size());
+      slotted.push_back(t);
+    }
+  }
+  const auto count = static_cast<Eigen::Index>(slotted.size());
+  if (barrier_force_.cols() < 2 * count) {  // grown only: the next evaluations reuse it
+    barrier_force_.resize(3, 2 * count);
+    barrier_normal_force_.resize(3, count);
+  }
+  tbb::parallel_for(tbb::blocked_range<Eigen::Index>(0, count, 256),
+                    [&](const tbb::blocked_range<Eigen::Index>& range) {
+                      for (Eigen::Index k = range.begin(); k != range.end(); ++k) {
+                        const TriangleTerms terms =
+                            triangle_terms(slotted[static_cast<std::size_t>(k)], x, normals, true);
+                        barrier_force_.col(2 * k) = terms.f0;
+                        barrier_force_.col(2 * k + 1) = terms.f1;
+                        barrier_normal_force_.col(k) = terms.fn;
+                      }
+                    });
+  return energies;
 }
 
 // Gathers the forces per particle in the fixed incidence order: no races, same bits for any thread
@@ -510,7 +545,11 @@ void SpringSystem::gather_gradient(bool with_barrier, Eigen::Matrix3Xd& gradient
                         if (with_barrier) {
                           for (int k = barrier_offset_[p]; k < barrier_offset_[p + 1]; ++k) {
                             const int code = barrier_entry_[k], role = code % 3;
-                            const auto col = 2 * static_cast<Eigen::Index>(code / 3);
+                            const int slot = barrier_slot_[static_cast<std::size_t>(code / 3)];
+                            if (slot < 0) {
+                              continue;  // no gradient
+                            }
+                            const auto col = 2 * static_cast<Eigen::Index>(slot);
                             if (role == 0) {
                               g += -(barrier_force_.col(col) + barrier_force_.col(col + 1));
                             } else {
@@ -532,7 +571,11 @@ void SpringSystem::gather_normal_gradient(Eigen::Matrix3Xd& normal_gradient) con
                         Eigen::Vector3d g = Eigen::Vector3d::Zero();
                         for (int k = barrier_offset_[p]; k < barrier_offset_[p + 1]; ++k) {
                           // Every corner of a triangle has the same dE/dn (its sum s).
-                          g += barrier_normal_force_.col(barrier_entry_[k] / 3);
+                          const int slot =
+                              barrier_slot_[static_cast<std::size_t>(barrier_entry_[k] / 3)];
+                          if (slot >= 0) {
+                            g += barrier_normal_force_.col(slot);
+                          }
                         }
                         normal_gradient.col(p) = g;
                       }

@@ -223,6 +223,15 @@ class SpringSystem {
   // gather of those forces into the gradient.
   double length_energy(const Eigen::Matrix3Xd& x, bool want_gradient) const;
   double angular_energy(const Eigen::Matrix3Xd& x, bool want_gradient) const;
+  // One barrier triangle's terms (spring_energy.cpp).
+  struct TriangleTerms {
+    double barrier = 0.0, distortion = 0.0;
+    bool has_gradient = false;  // a non-zero dE/da or dE/dD
+    Eigen::Vector3d f0 = Eigen::Vector3d::Zero(), f1 = Eigen::Vector3d::Zero();  // next, prev
+    Eigen::Vector3d fn = Eigen::Vector3d::Zero();  // dE/dn of each corner
+  };
+  TriangleTerms triangle_terms(std::size_t t, const Eigen::Matrix3Xd& x,
+                               const Eigen::Matrix3Xd* normals, bool gradient) const;
   Eigen::Vector2d triangle_energy(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd* normals,
                                   bool want_gradient) const;
   void gather_gradient(bool with_barrier, Eigen::Matrix3Xd& gradient) const;
@@ -253,12 +262,14 @@ class SpringSystem {
   std::vector<char> barrier_active_;
   std::vector<int> barrier_offset_,
       barrier_entry_;  // code 3 * triangle + role (0 i, 1 next, 2 prev)
-  // 2 columns per triangle: dE/dx of next and prev (that of i is minus their sum: a third less
-  // memory, 96 MB at a million particles).
+  // The last evaluation's barrier forces, for the triangles that had any: barrier_slot_[t] is
+  // triangle t's slot (-1: none); 2 columns per slot, dE/dx of next and prev (that of i is minus
+  // their sum), and dE/dn of its corners (with normals).
+  mutable std::vector<int> barrier_slot_;
   mutable Eigen::Matrix3Xd barrier_force_;
-  mutable Eigen::Matrix3Xd barrier_normal_force_;  // per triangle: dE/dn_i (with normals)
-  mutable Eigen::Matrix3Xd spring_force_;          // per spring: dE/dx_j
-  mutable Eigen::Matrix3Xd angular_force_;         // per angular spring: dE/dx_i
+  mutable Eigen::Matrix3Xd barrier_normal_force_;
+  mutable Eigen::Matrix3Xd spring_force_;   // per spring: dE/dx_j
+  mutable Eigen::Matrix3Xd angular_force_;  // per angular spring: dE/dx_i
 };
 
 /// Convenience: builds a SpringSystem and evaluates it once.
