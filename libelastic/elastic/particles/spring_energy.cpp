@@ -476,7 +476,7 @@ Eigen::Vector2d SpringSystem::triangle_energy(const Eigen::Matrix3Xd& x,
   if (want_gradient) {
     barrier_slot_.resize(barrier_.size());
   }
-  const Eigen::Vector2d energies = tbb::parallel_deterministic_reduce(
+  Eigen::Vector2d energies = tbb::parallel_deterministic_reduce(
       tbb::blocked_range<std::size_t>(0, barrier_.size(), kGrain), Eigen::Vector2d(0.0, 0.0),
       [&](const tbb::blocked_range<std::size_t>& range, Eigen::Vector2d sum) {
         for (std::size_t t = range.begin(); t != range.end(); ++t) {
