@@ -265,10 +265,7 @@ int SpringSystem::set_barrier_mask(const Eigen::Matrix3Xd& x, const Eigen::Matri
 SpringEnergies SpringSystem::evaluate(const Eigen::Matrix3Xd& x, Eigen::Matrix3Xd* gradient,
                                       const Eigen::Matrix3Xd* normals,
                                       Eigen::Matrix3Xd* normal_gradient) const {
-  if (x.cols() != num_particles_) {
-    throw InvalidInputError("particle positions", "expected " + std::to_string(num_particles_) +
-                                                      " columns, got " + std::to_string(x.cols()));
-  }
+  check_positions(x);
   const bool want_gradient = gradient != nullptr;
   SpringEnergies energies;
   energies.length = length_energy(x, want_gradient);
@@ -293,12 +290,16 @@ SpringEnergies SpringSystem::evaluate(const Eigen::Matrix3Xd& x, Eigen::Matrix3X
   return energies;
 }
 
-SpringEnergies SpringSystem::evaluate_springs(const Eigen::Matrix3Xd& x,
-                                              Eigen::Matrix3Xd* gradient) const {
+void SpringSystem::check_positions(const Eigen::Matrix3Xd& x) const {
   if (x.cols() != num_particles_) {
     throw InvalidInputError("particle positions", "expected " + std::to_string(num_particles_) +
                                                       " columns, got " + std::to_string(x.cols()));
   }
+}
+
+SpringEnergies SpringSystem::evaluate_springs(const Eigen::Matrix3Xd& x,
+                                              Eigen::Matrix3Xd* gradient) const {
+  check_positions(x);
   SpringEnergies energies;
   energies.length = length_energy(x, gradient != nullptr);
   energies.angular = angular_energy(x, gradient != nullptr);
@@ -379,8 +380,9 @@ double SpringSystem::angular_energy(const Eigen::Matrix3Xd& x, bool want_gradien
 //   dD/dT0 = 2 T1 x m,              dD/dT1 = 2 m x T0.
 // A collapsed (or, with normals, inverted) target triangle has infinite energy: the line search
 // backs off.
-// One barrier triangle's terms at x (see the header's energies): E_bar, E_sd, and with
-// `gradient` dE/dx_next, dE/dx_prev (corner i's is minus their sum) and dE/dn of its corners.
+//
+// triangle_terms: one barrier triangle's terms at x, E_bar and E_sd, and with `gradient`
+// dE/dx_next, dE/dx_prev (corner i's is minus their sum) and dE/dn of its corners.
 SpringSystem::TriangleTerms SpringSystem::triangle_terms(std::size_t t, const Eigen::Matrix3Xd& x,
                                                          const Eigen::Matrix3Xd* normals,
                                                          bool gradient) const {

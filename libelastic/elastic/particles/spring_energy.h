@@ -219,6 +219,8 @@ class SpringSystem {
 
  private:
   void build_barrier(const ParticleGrid& grid);
+  // Throws InvalidInputError unless x has a column per particle.
+  void check_positions(const Eigen::Matrix3Xd& x) const;
   // The three terms of evaluate(), each filling its force buffer when want_gradient, and the
   // gather of those forces into the gradient.
   double length_energy(const Eigen::Matrix3Xd& x, bool want_gradient) const;

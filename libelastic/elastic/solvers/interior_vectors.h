@@ -3,6 +3,12 @@
 /// The L-BFGS solver's vectors over the interior particles (internal to the solvers, like
 /// solver_common.h): chunked parallel kernels whose reductions give the same bits for any number
 /// of threads, and the layout of interior vectors with their projection on the tangent spaces.
+///
+/// dot and axpy do what numerics/vector_kernels.h's parallel_dot and parallel_axpy do, with
+/// another fixed summation order (TBB's deterministic reduce over 16,384-entry chunks against
+/// 4,096-entry blocks added in order) and mixed precision for the single-precision L-BFGS pairs.
+/// One of the two should go; which order stays changes the bits of every map (docs/results.md
+/// then needs regenerating), so it is a change of its own.
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>

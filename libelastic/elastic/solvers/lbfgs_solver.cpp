@@ -366,6 +366,13 @@ class LbfgsRun {
         sum_chunks(m_, [&](Eigen::Index i) { return is_held(i) ? 0.0 : v[i] * v[i]; }));
   }
 
+  // Whether the barrier's energy is at most `share` times the springs' (E_len + E_ang): where it is
+  // above, its stiffest triangles dominate the curvature, and neither the Newton H0 nor the
+  // pairs' scale of L^-1 is used.
+  bool barrier_within(double share) const {
+    return energies_.barrier <= share * (energies_.length + energies_.angular);
+  }
+
   // Which H0 this iteration uses (NewtonOptions): the Newton H0 once `after` iterations have
   // passed (at once for NewtonMode::On) while the barrier's energy is within its share of the
   // springs', refactorised every `refresh` iterations; else L^-1. A change of H0 clears the
@@ -376,8 +383,7 @@ class LbfgsRun {
     }
     const NewtonOptions& newton = lb_.newton;
     const long after = newton.mode == NewtonMode::On ? 0 : newton.after;
-    bool use = iteration_ >= after &&
-               energies_.barrier <= newton.barrier_share * (energies_.length + energies_.angular);
+    bool use = iteration_ >= after && barrier_within(newton.barrier_share);
     if (use && !newton_) {  // built at its first use: most solves converge before `after`
       newton_.emplace(setup_, newton_laplacian_);
       newton_laplacian_ = Eigen::SparseMatrix<double>();  // the operator holds its copy
@@ -432,8 +438,7 @@ class LbfgsRun {
       axpy(-alphas[k], memory_[k].y, direction_);
     }
     apply_h0(direction_);
-    scaled_ = !memory_.empty() && memory_.back().gamma > 0.0 &&
-              energies_.barrier <= energies_.length + energies_.angular;
+    scaled_ = !memory_.empty() && memory_.back().gamma > 0.0 && barrier_within(1.0);
     if (scaled_) {
       direction_ *= memory_.back().gamma;  // LbfgsOptions::scale_h0
     }
