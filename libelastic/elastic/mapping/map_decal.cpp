@@ -256,8 +256,7 @@ std::unique_ptr<Region> cut_target_region(const SurfaceProjector& target, const 
     spec.anchor = relaxed.positions.col(loop.front());
     const bool last = k + 1 == tries.size();
     try {
-      return std::make_unique<Region>(
-          make_region(target, spec, {.name = name, .euclidean_bands = true}));
+      return std::make_unique<Region>(make_region(target, spec, {.name = name}));
     } catch (const InvalidInputError& e) {
       if (last) {
         throw InvalidInputError(name, std::string("the decal's boundary does not bound a disk on "

@@ -137,8 +137,12 @@ struct ExactGeodesics::Impl {
   /// A triangle holding every vertex of both weight sets, or -1.
   int common_triangle(const Weights& a, const Weights& b) const {
     std::vector<int> need;
-    for (const auto& [v, w] : a.w) need.push_back(v);
-    for (const auto& [v, w] : b.w) need.push_back(v);
+    for (const auto& [v, w] : a.w) {
+      need.push_back(v);
+    }
+    for (const auto& [v, w] : b.w) {
+      need.push_back(v);
+    }
     for (int t : vertex_triangles[static_cast<size_t>(need.front())]) {
       const Eigen::Vector3i& c = tri[static_cast<size_t>(t)];
       if (std::all_of(need.begin(), need.end(),
@@ -217,8 +221,8 @@ std::vector<char> geodesic_band(const std::vector<Eigen::Vector3i>& triangles,
   return band;
 }
 
-std::vector<PathNode> ExactGeodesics::path(const MeshLocation& from, const MeshLocation& to,
-                                           const std::vector<char>& band) {
+GeodesicPath ExactGeodesics::path(const MeshLocation& from, const MeshLocation& to,
+                                  const std::vector<char>& band) {
   if (band.size() != impl_->tri.size()) {
     throw NumericalError(impl_->name, "internal: the geodesic band is not one flag per triangle");
   }
@@ -231,8 +235,8 @@ std::vector<PathNode> ExactGeodesics::path(const MeshLocation& from, const MeshL
   return path(from, to, list);
 }
 
-std::vector<PathNode> ExactGeodesics::path(const MeshLocation& from, const MeshLocation& to,
-                                           const std::vector<int>& band) {
+GeodesicPath ExactGeodesics::path(const MeshLocation& from, const MeshLocation& to,
+                                  const std::vector<int>& band) {
   Impl& m = *impl_;
   m.build(band);
   if (m.face_of[static_cast<size_t>(from.triangle)] < 0 ||
@@ -288,14 +292,15 @@ std::vector<PathNode> ExactGeodesics::path(const MeshLocation& from, const MeshL
   seq.push_back(m.weights_of(to));
   seq = m.drop_crossings_near_ends(seq, from, to);
 
-  std::vector<PathNode> out;
+  GeodesicPath out;
+  out.length = result.first;
   for (size_t i = 0; i + 1 < seq.size(); ++i) {
     const int t = m.common_triangle(seq[i], seq[i + 1]);
     if (t < 0) {
       throw NumericalError(m.name, "internal: consecutive shortest-path points share no triangle");
     }
     const MeshLocation loc = i == 0 ? from : m.location_in(seq[i], t);
-    out.push_back({loc, t});
+    out.nodes.push_back({loc, t});
   }
   return out;
 }

@@ -36,6 +36,12 @@ std::vector<char> geodesic_band(const std::vector<Eigen::Vector3i>& triangles,
                                 const Eigen::VectorXd& d_from, const Eigen::VectorXd& d_to,
                                 double slack, double margin);
 
+/// A shortest path: its nodes and its length.
+struct GeodesicPath {
+  std::vector<PathNode> nodes;  ///< from `from` up to, not including, `to`
+  double length = 0.0;          ///< along the surface (CGAL's, between the ends moved kInside)
+};
+
 class ExactGeodesics {
  public:
   /// Keeps the mesh (by reference: it must outlive this object).
@@ -46,18 +52,18 @@ class ExactGeodesics {
   ExactGeodesics& operator=(const ExactGeodesics&) = delete;
 
   /// The shortest path from `from` to `to` among the triangles with band[t] set: nodes from `from`
-  /// up to, not including, `to`, each with a triangle that holds it and the next node. CGAL's
+  /// up to, not including, `to`, each with a triangle that holds it and the next node, and its
+  /// length. CGAL's
   /// sequence tree grows over every triangle it is given (about a minute and a gigabyte on a
   /// 30,000-triangle plane), so the caller restricts the search to a band around the path
   /// (`geodesic_band`); both end points' triangles must be in it. \throws InvalidInputError when
   /// the band is not an oriented 2-manifold, NumericalError when `to` is unreachable from `from`
   /// inside it.
-  std::vector<PathNode> path(const MeshLocation& from, const MeshLocation& to,
-                             const std::vector<char>& band);
+  GeodesicPath path(const MeshLocation& from, const MeshLocation& to,
+                    const std::vector<char>& band);
   /// The same with the band as its triangles' indices in increasing order (a small band of a large
   /// tessellation costs its own size, not the tessellation's).
-  std::vector<PathNode> path(const MeshLocation& from, const MeshLocation& to,
-                             const std::vector<int>& band);
+  GeodesicPath path(const MeshLocation& from, const MeshLocation& to, const std::vector<int>& band);
 
  private:
   struct Impl;

@@ -8,13 +8,11 @@
 #include <functional>
 #include <limits>
 #include <sstream>
-#include <unordered_map>
 
 #include "elastic/core/error.h"
 #include "elastic/projection/closest_point.h"
 #include "elastic/regions/cut_mesh.h"
-#include "elastic/regions/exact_geodesics.h"
-#include "elastic/regions/heat_geodesics.h"
+#include "elastic/regions/polygon_sides.h"
 #include "elastic/regions/region_context.h"
 
 namespace elastic::regions_detail {
@@ -262,117 +260,6 @@ void embed_curve(CutMesh& cut, const std::vector<MeshLocation>& nodes, Chart cha
   }
 }
 
-/// The bands the sides of a `points:` polygon are searched in (RegionOptions::euclidean_bands):
-/// from heat distances (computed the first time a side needs them) or from 3D distances.
-class SideBands {
- public:
-  SideBands(const Context& ctx, const std::vector<MeshLocation>& locs,
-            const std::vector<Eigen::Vector3d>& where)
-      : ctx_(ctx), locs_(locs), where_(where) {
-    if (ctx.options.euclidean_bands) {
-      index_vertices();
-    }
-  }
-
-  std::vector<char> heat(size_t i, size_t j) {
-    if (!heat_) {
-      heat_ = std::make_unique<regions_detail::HeatGeodesics>(
-          ctx_.tess.positions, ctx_.tess.triangles, ctx_.options.name);
-      dist_.resize(locs_.size());
-    }
-    for (const size_t k : {i, j}) {
-      if (dist_[k].size() == 0) {
-        dist_[k] = heat_->distance(locs_[k]);
-      }
-    }
-    return regions_detail::geodesic_band(ctx_.tess.triangles, dist_[i], dist_[j], 0.5,
-                                         4.0 * heat_->mean_edge_length());
-  }
-
-  /// The triangles with a corner v whose distances to the two ends add up to at most the bound
-  /// (geodesic_band's rule with 3D distances), found among the vertices near the first end, in
-  /// increasing order.
-  std::vector<int> euclidean(size_t i, size_t j) {
-    const Eigen::Vector3d& a = where_[i];
-    const Eigen::Vector3d& b = where_[j];
-    const double bound = this->bound(i, j);
-    std::vector<int> band;
-    const Eigen::Vector3i c = cell(a);
-    for (int dx = -1; dx <= 1; ++dx) {
-      for (int dy = -1; dy <= 1; ++dy) {
-        for (int dz = -1; dz <= 1; ++dz) {
-          const auto found = cells_.find(key(c + Eigen::Vector3i(dx, dy, dz)));
-          if (found == cells_.end()) {
-            continue;
-          }
-          for (const int v : found->second) {
-            const Eigen::Vector3d& x = ctx_.tess.positions[static_cast<size_t>(v)];
-            if ((x - a).norm() + (x - b).norm() > bound) {
-              continue;
-            }
-            for (const int t : vertex_triangles_[static_cast<size_t>(v)]) {
-              band.push_back(t);
-            }
-          }
-        }
-      }
-    }
-    std::sort(band.begin(), band.end());
-    band.erase(std::unique(band.begin(), band.end()), band.end());
-    return band;
-  }
-
- private:
-  double bound(size_t i, size_t j) const {
-    return 1.5 * (where_[i] - where_[j]).norm() + 4.0 * mean_edge_;
-  }
-  Eigen::Vector3i cell(const Eigen::Vector3d& x) const {
-    return (x / cell_size_).array().floor().cast<int>();
-  }
-  static std::uint64_t key(const Eigen::Vector3i& c) {
-    const auto h = [](int v) { return static_cast<std::uint64_t>(static_cast<std::uint32_t>(v)); };
-    return (h(c.x()) * 73856093ULL) ^ (h(c.y()) * 19349663ULL) ^ (h(c.z()) * 83492791ULL);
-  }
-
-  // Vertices hashed in cells at least as wide as any side's bound (a vertex within the bound of
-  // the first end is in its cell or a neighbour), and each vertex's triangles.
-  void index_vertices() {
-    const auto& x = ctx_.tess.positions;
-    const auto& triangles = ctx_.tess.triangles;
-    double sum = 0.0;
-    vertex_triangles_.resize(x.size());
-    for (size_t t = 0; t < triangles.size(); ++t) {
-      for (int k = 0; k < 3; ++k) {
-        sum += (x[static_cast<size_t>(triangles[t][k])] -
-                x[static_cast<size_t>(triangles[t][(k + 1) % 3])])
-                   .norm();
-        vertex_triangles_[static_cast<size_t>(triangles[t][k])].push_back(static_cast<int>(t));
-      }
-    }
-    mean_edge_ = triangles.empty() ? 0.0 : sum / (3.0 * static_cast<double>(triangles.size()));
-    cell_size_ = 4.0 * mean_edge_;
-    for (size_t i = 0; i < where_.size(); ++i) {
-      cell_size_ = std::max(cell_size_, bound(i, (i + 1) % where_.size()));
-    }
-    if (!(cell_size_ > 0.0)) {
-      cell_size_ = 1.0;
-    }
-    for (size_t v = 0; v < x.size(); ++v) {
-      cells_[key(cell(x[v]))].push_back(static_cast<int>(v));
-    }
-  }
-
-  const Context& ctx_;
-  const std::vector<MeshLocation>& locs_;
-  const std::vector<Eigen::Vector3d>& where_;
-  double mean_edge_ = 0.0;
-  double cell_size_ = 1.0;
-  std::vector<std::vector<int>> vertex_triangles_;
-  std::unordered_map<std::uint64_t, std::vector<int>> cells_;
-  std::unique_ptr<regions_detail::HeatGeodesics> heat_;
-  std::vector<Eigen::VectorXd> dist_;
-};
-
 Region points_region(const Context& ctx, const RegionSpec& spec) {
   const std::string& name = ctx.options.name;
   std::vector<MeshLocation> locs;
@@ -401,28 +288,11 @@ Region points_region(const Context& ctx, const RegionSpec& spec) {
                                 std::to_string(locs.size()));
   }
   // The sides are exact polyhedral shortest paths on the tessellation (exact_geodesics.h explains
-  // why not the heat method's traced paths).
-  // The search for each side is confined to the band of paths at most 50% longer than the
-  // shortest (plus four edges for the heat distance's error) around it.
-  regions_detail::ExactGeodesics geodesics(ctx.tess.positions, ctx.tess.triangles, name);
-  SideBands bands(ctx, locs, where);
+  // why not the heat method's traced paths), each searched in a band around it (polygon_sides.h).
   std::vector<MeshLocation> nodes;
-  for (size_t i = 0; i < locs.size(); ++i) {
-    const size_t j = (i + 1) % locs.size();
-    std::vector<regions_detail::PathNode> path;
-    if (ctx.options.euclidean_bands) {
-      try {
-        path = geodesics.path(locs[i], locs[j], bands.euclidean(i, j));
-      } catch (const Error&) {
-        // The chord's band does not hold the path (or is not a manifold where it pinches
-        // between two sheets): the heat band below.
-        path.clear();
-      }
-    }
-    if (path.empty()) {
-      path = geodesics.path(locs[i], locs[j], bands.heat(i, j));
-    }
-    for (const auto& node : path) {
+  for (const regions_detail::PolygonSide& side :
+       regions_detail::polygon_sides(ctx.tess.positions, ctx.tess.triangles, locs, name)) {
+    for (const auto& node : side.path.nodes) {
       // Express the node in the triangle that holds the segment leaving it.
       MeshLocation m{node.segment_triangle, Eigen::Vector3d::Zero()};
       const Eigen::Vector3i& from = ctx.tess.triangles[static_cast<size_t>(node.location.triangle)];

@@ -56,15 +56,6 @@ struct RegionOptions {
   double max_point_distance = 0.05;
   /// Name used in error messages, e.g. "--target-region".
   std::string name = "region";
-  /// `points:` only. Each side's exact shortest path is searched in a band of the tessellation
-  /// around it: by default the band of the heat method's distances from both ends (one heat solve
-  /// per point: right for any polygon a user draws). When set, the band of the 3D distances from
-  /// both ends instead (triangles whose corners' distances to the two ends add up to at most 1.5
-  /// times the ends' distance plus four tessellation edges), which needs no solve: for many
-  /// closely spaced points along a smooth curve, whose sides are nearly straight chords (a placed
-  /// decal's relaxed boundary, mapping/map_decal.h). A side whose path the band does not hold
-  /// falls back to the heat band.
-  bool euclidean_bands = false;
   /// `disk:` only. The heat method runs on the tessellation within twice the radius of the disk's
   /// centre, whose two sparse factorisations cost O(n^1.5) in its vertices (7 s for a large disk
   /// on a 228,000-vertex tessellation). Above this many vertices it runs instead on a coarser
