@@ -14,51 +14,17 @@
 #include "elastic/core/error.h"
 #include "elastic/mesh/mesh_io.h"
 #include "elastic/projection/closest_point.h"
-#include "elastic/regions/heat_geodesics.h"
-#include "elastic/regions/polygon_sides.h"
 #include "elastic/regions/region_context.h"
 #include "elastic/regions/region_spec.h"
 #include "elastic/regions/texture_coordinates.h"
 #include "elastic/shapes/procedural_shapes.h"
+#include "region_fixture.h"
 #include "support.h"
 
 namespace elastic {
 namespace {
 
 constexpr double kPi = std::numbers::pi;
-
-/// A control mesh, its limit surface and a projector, kept together (the surface must outlive
-/// users).
-struct Fixture {
-  std::unique_ptr<LimitSurface> surface;
-  std::unique_ptr<SurfaceProjector> projector;
-  explicit Fixture(const PolygonMesh& mesh, int tess_resolution = 8) {
-    surface = std::make_unique<LimitSurface>(mesh);
-    ProjectionOptions options;
-    options.tessellation.resolution = tess_resolution;
-    projector = std::make_unique<SurfaceProjector>(*surface, options);
-  }
-  /// The limit surface point nearest x (test inputs placed exactly on the surface).
-  Eigen::Vector3d on_surface(const Eigen::Vector3d& x) const {
-    return projector->closest(x).position;
-  }
-  double mean_edge() const {
-    const LimitTessellation& t = projector->tessellation();
-    double sum = 0.0;
-    for (const auto& tri : t.triangles) {
-      for (int k = 0; k < 3; ++k) {
-        sum += (t.positions[static_cast<size_t>(tri[k])] -
-                t.positions[static_cast<size_t>(tri[(k + 1) % 3])])
-                   .norm();
-      }
-    }
-    return sum / static_cast<double>(3 * t.triangles.size());
-  }
-};
-
-PolygonMesh plane_mesh() {
-  return make_plane({.faces = ShapeFaces::Quads, .resolution = 8});
-}
 
 /// The plane with texture coordinates (x+1)/2, (y+1)/2 at every corner.
 PolygonMesh textured_plane() {
@@ -201,6 +167,32 @@ TEST(DiskRegion, DiskOfFewTessellationEdgesIsStillRound) {
 // 0.65, twice the disk's radius): the geodesic circle at angle R / rho from the centre. Measured:
 // within 3.2% of R, area within 0.4% of the cap's (before: 10 boundary vertices, 110% off, twice
 // the area).
+// RegionOptions::cache: a disk dragged in small steps on a sphere reuses the heat method's
+// factorisations (one build for four disks), and each cached cut is the disk cut afresh within the
+// heat method's error: the same area within 1% and every boundary vertex within 1.5 edges of the
+// geodesic circle.
+TEST(DiskRegion, CachedCutsOfADraggedDiskMatchFreshOnes) {
+  const Fixture fx(make_sphere({.faces = ShapeFaces::Quads, .resolution = 12}), 6);
+  RegionCache cache;
+  const double r = 0.5, h = fx.mean_edge();
+  for (int step = 0; step < 4; ++step) {
+    const Eigen::Vector3d dir = Eigen::Vector3d(0.03 * step, 0.2, 1.0).normalized();
+    const ClosestPoint centre = fx.projector->closest(dir);
+    const Region fresh = make_region(*fx.projector, disk(centre.position, r));
+    const Region cached =
+        make_region(*fx.projector, disk(centre.position, r), {.name = "cached", .cache = &cache});
+    expect_consistent(cached);
+    EXPECT_NEAR(cached.area(), fresh.area(), 0.01 * fresh.area()) << "step " << step;
+    const double rho = centre.position.norm();
+    for (const int v : cached.boundary) {
+      const Eigen::Vector3d& x = cached.positions[static_cast<size_t>(v)];
+      const double angle = std::acos(std::clamp(x.normalized().dot(dir), -1.0, 1.0));
+      EXPECT_NEAR(angle * rho, r, 1.5 * h + 0.05 * r) << "step " << step;
+    }
+  }
+  EXPECT_EQ(cache.impl().disk_distance.builds(), 1);
+}
+
 TEST(DiskRegion, CoarseSphereDiskIsAGeodesicCircle) {
   const Fixture fx(make_sphere({.faces = ShapeFaces::Quads, .resolution = 6}), 1);
   const Eigen::Vector3d dir = Eigen::Vector3d(1.0, 2.0, 2.0).normalized();
@@ -250,65 +242,6 @@ TEST(DiskRegion, ALargeDiskMeasuredOnACoarserTessellationIsStillAGeodesicCircle)
   }
   // And the two agree far closer than that.
   EXPECT_NEAR(coarse.area(), fine.area(), 0.005 * fine.area());
-}
-
-// A flat grid mesh of (n + 1)^2 vertices on [-half, half]^2 at height z, appended to `positions`
-// and `triangles` (two triangles per cell, counter-clockwise seen from +z).
-void append_grid(int n, double half, double z, std::vector<Eigen::Vector3d>& positions,
-                 std::vector<Eigen::Vector3i>& triangles) {
-  const int base = static_cast<int>(positions.size());
-  for (int i = 0; i <= n; ++i) {
-    for (int j = 0; j <= n; ++j) {
-      positions.emplace_back(-half + 2.0 * half * j / n, -half + 2.0 * half * i / n, z);
-    }
-  }
-  const auto v = [&](int i, int j) { return base + i * (n + 1) + j; };
-  for (int i = 0; i < n; ++i) {
-    for (int j = 0; j < n; ++j) {
-      triangles.emplace_back(v(i, j), v(i, j + 1), v(i + 1, j + 1));
-      triangles.emplace_back(v(i, j), v(i + 1, j + 1), v(i + 1, j));
-    }
-  }
-}
-
-// The disk's local heat distance: on a plane the geodesic distance is the Euclidean one, so within
-// the reach it must match |x - c| to the heat method's error (a few edges near the source, O(h)
-// beyond); vertices farther than twice the reach, and a second sheet 0.05 above the plane (inside
-// the Euclidean ball but not connected to the source), get `far`; a reach that covers the mesh
-// falls back to the whole mesh, bit for bit.
-TEST(LocalGeodesics, PlaneDistanceWithinReachAndFarBeyond) {
-  std::vector<Eigen::Vector3d> x;
-  std::vector<Eigen::Vector3i> tri;
-  const int n = 80;
-  const double half = 1.0, h = 2.0 * half / n, reach = 0.3, far = 10.0;
-  append_grid(n, half, 0.0, x, tri);
-  const int sheet = static_cast<int>(x.size());
-  append_grid(8, 0.2, 0.05, x, tri);
-  // The source at the plane's centre vertex (row 40, column 40): corner 0 of that cell's triangle.
-  const regions_detail::MeshLocation source{2 * (40 * n + 40), Eigen::Vector3d(1.0, 0.0, 0.0)};
-  ASSERT_LT(x[static_cast<size_t>(tri[static_cast<size_t>(source.triangle)][0])].norm(), 1e-12);
-  const Eigen::VectorXd d =
-      regions_detail::local_geodesic_distance(x, tri, source, reach, far, "plane");
-  int within = 0, beyond = 0;
-  for (int v = 0; v < sheet; ++v) {
-    const double r = x[static_cast<size_t>(v)].norm();
-    if (r <= reach) {
-      EXPECT_NEAR(d[v], r, 2.0 * h) << v;
-      ++within;
-    } else if (r > 2.0 * reach + 2.0 * h) {
-      EXPECT_EQ(d[v], far) << v;
-      ++beyond;
-    }
-  }
-  EXPECT_GT(within, 400);
-  EXPECT_GT(beyond, 4000);
-  for (int v = sheet; v < static_cast<int>(x.size()); ++v) {
-    EXPECT_EQ(d[v], far) << "vertex " << v << " of the unconnected sheet";
-  }
-  const Eigen::VectorXd whole =
-      regions_detail::local_geodesic_distance(x, tri, source, 5.0, far, "plane");
-  const Eigen::VectorXd reference = regions_detail::HeatGeodesics(x, tri, "plane").distance(source);
-  EXPECT_EQ((whole - reference).cwiseAbs().maxCoeff(), 0.0);
 }
 
 TEST(BoundaryRegion, CapIsTheWholeCapCounterClockwiseAboutItsNormal) {
@@ -401,82 +334,6 @@ TEST(PointsRegion, CornersOnTessellationEdgesKeepTheSidesStraight) {
   // Between path nodes the cut is straight in the patch's (u, v), not in space: up to 4e-4 near
   // the corners on this coarse plane.
   EXPECT_LT(worst, 1e-3);
-}
-
-/// Each side of polygon_sides() against the exact shortest path among all the triangles, and the
-/// band each side was found in.
-std::vector<regions_detail::SideBand> expect_sides_are_shortest(
-    const Fixture& fx, const std::vector<Eigen::Vector3d>& polygon) {
-  const LimitTessellation& tess = fx.projector->tessellation();
-  const regions_detail::RegionContext ctx(*fx.projector, {});
-  std::vector<regions_detail::MeshLocation> corners;
-  for (const Eigen::Vector3d& x : polygon) {
-    corners.push_back(ctx.project(x, "corner"));
-  }
-  const std::vector<regions_detail::PolygonSide> sides =
-      regions_detail::polygon_sides(tess.positions, tess.triangles, corners, "sides");
-  std::vector<int> everything(tess.triangles.size());
-  std::iota(everything.begin(), everything.end(), 0);
-  regions_detail::ExactGeodesics whole(tess.positions, tess.triangles, "whole");
-  std::vector<regions_detail::SideBand> bands;
-  EXPECT_EQ(sides.size(), corners.size());
-  for (size_t i = 0; i < sides.size(); ++i) {
-    const regions_detail::GeodesicPath truth =
-        whole.path(corners[i], corners[(i + 1) % corners.size()], everything);
-    const regions_detail::GeodesicPath& side = sides[i].path;
-    EXPECT_NEAR(side.length, truth.length, 1e-12 * truth.length) << "side " << i;
-    EXPECT_EQ(side.nodes.size(), truth.nodes.size()) << "side " << i;
-    for (size_t k = 0; k < std::min(side.nodes.size(), truth.nodes.size()); ++k) {
-      EXPECT_EQ(side.nodes[k].segment_triangle, truth.nodes[k].segment_triangle) << "side " << i;
-    }
-    bands.push_back(sides[i].band);
-  }
-  return bands;
-}
-
-// The sides of points: polygons (polygon_sides.h) are the shortest paths on the whole surface,
-// whichever band served them: the chord's (a small circle's sides, a triangle on a plane), the band
-// enclosing the path a chord's band gave (a cap's sides of 120 degrees, longer than the chord's
-// bound), or the heat method's (a side of nearly 180 degrees, whose chord's bands fall in two
-// pieces). The reference is CGAL's exact shortest path among all the triangles. (A case where the
-// chord's band gives a path other than the shortest, a side over a ridge with a gap, has a window
-// of a few edges; the counts of each band check the order of the steps instead.)
-TEST(PolygonSides, AreTheShortestPathsOnTheWholeSurface) {
-  using regions_detail::SideBand;
-  const auto count = [](const std::vector<SideBand>& bands, SideBand b) {
-    return std::count(bands.begin(), bands.end(), b);
-  };
-  const Fixture fx(make_sphere({.faces = ShapeFaces::Quads, .resolution = 12}), 6);
-  const Eigen::Vector3d centre = Eigen::Vector3d(0.3, 0.5, 0.8).normalized();
-  const Eigen::Vector3d a = centre.cross(Eigen::Vector3d::UnitX()).normalized();
-  const Eigen::Vector3d b = centre.cross(a);
-  std::vector<Eigen::Vector3d> circle;
-  for (int k = 0; k < 16; ++k) {
-    const double t = 2.0 * kPi * k / 16.0;
-    circle.push_back(fx.on_surface(centre + 0.6 * (std::cos(t) * a + std::sin(t) * b)));
-  }
-  EXPECT_EQ(count(expect_sides_are_shortest(fx, circle), SideBand::Chord), 16);
-  const std::vector<SideBand> cap =
-      expect_sides_are_shortest(fx, {fx.on_surface({1, 0, 0.3}), fx.on_surface({-0.5, 0.87, 0.3}),
-                                     fx.on_surface({-0.5, -0.87, 0.3})});
-  EXPECT_EQ(count(cap, SideBand::Enclosing), 3);
-  // On a finer sphere (the certificate's room, two edges, is smaller), a side between nearly
-  // antipodal points.
-  const Fixture fine(make_sphere({.faces = ShapeFaces::Quads, .resolution = 16}), 8);
-  const std::vector<SideBand> far = expect_sides_are_shortest(
-      fine,
-      {fine.on_surface({1, 0, 0}), fine.on_surface({-1, 0.05, 0}), fine.on_surface({0, -1, 0.6})});
-  EXPECT_EQ(count(far, SideBand::Heat), 1);
-  // The inner equator of a torus, where the surface is a saddle.
-  const Fixture torus(make_torus({.faces = ShapeFaces::Quads, .resolution = 12}), 4);
-  expect_sides_are_shortest(torus,
-                            {torus.on_surface({0.65, 0, 0}), torus.on_surface({0, 0.65, 0}),
-                             torus.on_surface({-0.65, 0, 0}), torus.on_surface({0, -0.65, 0})});
-  const Fixture plane(plane_mesh(), 4);
-  EXPECT_EQ(
-      count(expect_sides_are_shortest(plane, {{-0.7, -0.6, 0}, {0.7, -0.5, 0}, {0.1, 0.7, 0}}),
-            SideBand::Chord),
-      3);
 }
 
 TEST(PointsRegion, SphereTriangleIsOrientedAndSmallerSide) {

@@ -574,11 +574,6 @@ nlohmann::json StudioSession::resolve(const nlohmann::json& request) {
   std::string spec_text = request.value("spec", std::string());
   spec_text += anchor_suffix(request, "--target-region");
   const auto start = Clock::now();
-  const RegionSpec spec = parse_region_spec(spec_text, "--target-region");
-  warm_regions_.push_back(make_region(*s.target.projector, spec, {.name = "--target-region"}));
-  const double seconds_region = seconds_since(start);
-  const MapResult& previous = warm_previous_ ? *warm_previous_ : s.result;
-  MapOptions options = make_map_options(fin->job);
   // A live update while the user drags: the relaxation stops at the deadline (a Cancelled stop,
   // not converged) and the next update continues from where it stopped; the page asks for an
   // unbudgeted solve when the drag ends.
@@ -588,6 +583,13 @@ nlohmann::json StudioSession::resolve(const nlohmann::json& request) {
   if ((given != nullptr && !given->is_number()) || !std::isfinite(budget) || budget < 0.0) {
     throw UsageError("budget_seconds: expected a number of seconds >= 0");
   }
+  const RegionSpec spec = parse_region_spec(spec_text, "--target-region");
+  warm_regions_.push_back(
+      make_region(*s.target.projector, spec,
+                  {.name = "--target-region", .cache = budget > 0.0 ? &live_regions_ : nullptr}));
+  const double seconds_region = seconds_since(start);
+  const MapResult& previous = warm_previous_ ? *warm_previous_ : s.result;
+  MapOptions options = make_map_options(fin->job);
   if (budget > 0.0) {
     // The budget counts from the request's start; the relaxation makes at least
     // kMinLiveIterations steps even when the region cut and its set-up took the budget.

@@ -128,6 +128,9 @@ class StudioSession {
   std::mutex warm_mutex_;
   std::deque<Region> warm_regions_;
   std::unique_ptr<MapResult> warm_previous_;
+  // The budgeted re-solves' disk cuts keep the heat method's factorisations of the neighbourhood
+  // (RegionCache; the unbudgeted one at the drag's end cuts afresh, as the CLI does).
+  RegionCache live_regions_;
 };
 
 }  // namespace elastic::cli

@@ -406,6 +406,10 @@ Eigen::VectorXd disk_distance(const RegionContext& ctx, const MeshLocation& cent
   }
   const long budget = ctx.options.max_heat_vertices;
   const auto fine_distance = [&] {
+    if (ctx.options.cache != nullptr) {
+      return ctx.options.cache->impl().disk_distance.distance(tess.positions, tess.triangles,
+                                                              centre, radius, 4.0 * radius, name);
+    }
     return local_geodesic_distance(tess.positions, tess.triangles, centre, radius, 4.0 * radius,
                                    name);
   };

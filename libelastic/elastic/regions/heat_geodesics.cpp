@@ -8,6 +8,7 @@
 #include <cmath>
 #include <limits>
 #include <mutex>
+#include <numeric>
 
 #include "elastic/core/directed_edges.h"
 #include "elastic/core/error.h"
@@ -215,9 +216,7 @@ Eigen::VectorXd HeatGeodesics::distance(const MeshLocation& source) const {
   const int nv = static_cast<int>(x_.size());
   // Pin the source triangle's heaviest corner; solve Crane's Delta phi = div X on the other
   // vertices. Our L is positive semi-definite (L = -Delta), so the system is L phi = -div X.
-  int kmax = 0;
-  source.bary.maxCoeff(&kmax);
-  const int pin = tri_[static_cast<size_t>(source.triangle)][kmax];
+  const int pin = pin_of(source);
   // The Poisson factorisation needs only the pin: it runs beside the heat step (with the heat
   // operator's factorisation on first use) and the divergence, two factorisations of the same
   // cost at once (each on one thread, so the bits do not depend on the thread count).
@@ -242,6 +241,66 @@ Eigen::VectorXd HeatGeodesics::distance(const MeshLocation& source) const {
   for (int i = 0; i < nv; ++i) {
     phi[i] = i == pin ? 0.0 : y[i - (i > pin ? 1 : 0)];
   }
+  return shifted_to_source(std::move(phi), source);
+}
+
+int HeatGeodesics::pin_of(const MeshLocation& source) const {
+  int kmax = 0;
+  source.bary.maxCoeff(&kmax);
+  return tri_[static_cast<size_t>(source.triangle)][kmax];
+}
+
+void HeatGeodesics::factor_poisson() const {
+  std::call_once(poisson_factored_, [&] {
+    // A = L + kShift I + e_0 e_0^T: the pinned operator's shift (pinned_laplacian) and a rank-one
+    // term at vertex 0 that makes A positive definite on vertex 0's component.
+    constexpr double kShift = 1e-12;
+    Eigen::SparseMatrix<double> a = laplacian_;
+    for (int v = 0; v < a.cols(); ++v) {
+      a.coeffRef(v, v) += v == 0 ? kShift + 1.0 : kShift;
+    }
+    auto solver = std::make_unique<Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>>>(a);
+    if (solver->info() != Eigen::Success) {
+      throw NumericalError(name_, "heat method: factorisation of the Poisson problem failed");
+    }
+    poisson_w0_ = solver->solve(Eigen::VectorXd::Unit(a.cols(), 0));
+    poisson_solver_ = std::move(solver);
+  });
+}
+
+Eigen::VectorXd HeatGeodesics::distance_reusing(const MeshLocation& source) const {
+  // The pinned system of distance(), (L + kShift I) phi = b on every vertex but the pin p, with
+  // phi_p = 0, written with A = L + kShift I + e_0 e_0^T (factored once, factor_poisson) as
+  // A phi = b + mu e_p + nu e_0 with nu = phi_0 (mu frees row p). So phi = u + mu w_p + nu w_0
+  // with u = A^-1 b, w_p = A^-1 e_p, w_0 = A^-1 e_0, and mu, nu from the two conditions
+  //   phi_p = 0:    u_p + mu w_p[p] + nu w_0[p] = 0,
+  //   phi_0 = nu:   u_0 + mu w_p[0] + nu (w_0[0] - 1) = 0.
+  // (For p = 0 the second is phi_0 = 0 itself and nu drops out with w_p = w_0.)
+  const int pin = pin_of(source);
+  Eigen::VectorXd div;
+  tbb::parallel_invoke([&] { div = divergence(heat(source)); }, [&] { factor_poisson(); });
+  const auto& solver = *poisson_solver_;
+  const Eigen::VectorXd u = solver.solve(-div);
+  Eigen::VectorXd phi;
+  if (pin == 0) {
+    phi = u - (u[0] / poisson_w0_[0]) * poisson_w0_;
+  } else {
+    const Eigen::VectorXd wp = solver.solve(Eigen::VectorXd::Unit(u.size(), pin));
+    Eigen::Matrix2d m;
+    m << wp[pin], poisson_w0_[pin], wp[0], poisson_w0_[0] - 1.0;
+    const Eigen::Vector2d coef = m.fullPivLu().solve(Eigen::Vector2d(-u[pin], -u[0]));
+    phi = u + coef[0] * wp + coef[1] * poisson_w0_;
+    phi[pin] = 0.0;
+  }
+  if (solver.info() != Eigen::Success || !phi.allFinite()) {
+    throw NumericalError(name_, "heat method: Poisson solve failed");
+  }
+  return shifted_to_source(std::move(phi), source);
+}
+
+Eigen::VectorXd HeatGeodesics::shifted_to_source(Eigen::VectorXd phi,
+                                                 const MeshLocation& source) const {
+  const int nv = static_cast<int>(x_.size());
   double at_source = 0.0;
   for (int k = 0; k < 3; ++k) {
     at_source += source.bary[k] * phi[tri_[static_cast<size_t>(source.triangle)][k]];
@@ -273,19 +332,25 @@ Eigen::VectorXd HeatGeodesics::distance(const MeshLocation& source) const {
   return phi;
 }
 
-Eigen::VectorXd local_geodesic_distance(const std::vector<Eigen::Vector3d>& positions,
-                                        const std::vector<Eigen::Vector3i>& triangles,
-                                        const MeshLocation& source, double reach, double far,
-                                        const std::string& name) {
+namespace {
+
+/// The part of the mesh local_geodesic_distance works on: the triangles with a corner within `ball`
+/// of the source point, connected to the source's triangle through them.
+struct Part {
+  bool whole = false;                      ///< more than 70% of the triangles: the whole mesh
+  std::vector<int> global;                 ///< part vertex -> mesh vertex
+  std::vector<int> triangles;              ///< the mesh triangles in the part, increasing
+  std::vector<Eigen::Vector3d> positions;  ///< of the part's vertices
+  std::vector<Eigen::Vector3i> local;      ///< the part's triangles on its own vertices
+};
+
+Part select_part(const std::vector<Eigen::Vector3d>& positions,
+                 const std::vector<Eigen::Vector3i>& triangles, const Eigen::Vector3d& centre,
+                 int source_triangle, double ball) {
   const auto nt = triangles.size();
   const auto nv = positions.size();
-  const Eigen::Vector3i& home = triangles[static_cast<size_t>(source.triangle)];
-  const Eigen::Vector3d centre = source.bary[0] * positions[static_cast<size_t>(home[0])] +
-                                 source.bary[1] * positions[static_cast<size_t>(home[1])] +
-                                 source.bary[2] * positions[static_cast<size_t>(home[2])];
   // Triangles near the source, then the ones connected to the source's triangle through shared
   // corners (breadth first over vertex -> triangle incidences of the near ones).
-  const double ball = 2.0 * reach;
   std::vector<char> near(nv, 0), selected(nt, 0);
   for (size_t v = 0; v < nv; ++v) {
     near[v] = (positions[v] - centre).squaredNorm() <= ball * ball;
@@ -294,7 +359,7 @@ Eigen::VectorXd local_geodesic_distance(const std::vector<Eigen::Vector3d>& posi
   for (size_t t = 0; t < nt; ++t) {
     const Eigen::Vector3i& tri = triangles[t];
     if (near[static_cast<size_t>(tri[0])] || near[static_cast<size_t>(tri[1])] ||
-        near[static_cast<size_t>(tri[2])] || static_cast<int>(t) == source.triangle) {
+        near[static_cast<size_t>(tri[2])] || static_cast<int>(t) == source_triangle) {
       selected[t] = 1;
       for (int k = 0; k < 3; ++k) {
         ++start[static_cast<size_t>(tri[k]) + 1];
@@ -315,8 +380,10 @@ Eigen::VectorXd local_geodesic_distance(const std::vector<Eigen::Vector3d>& posi
     }
   }
   std::vector<char> reached(nt, 0);
-  std::vector<int> queue{source.triangle};
-  reached[static_cast<size_t>(source.triangle)] = 1;
+  Part part;
+  std::vector<int>& queue = part.triangles;
+  queue.push_back(source_triangle);
+  reached[static_cast<size_t>(source_triangle)] = 1;
   for (size_t q = 0; q < queue.size(); ++q) {
     for (int k = 0; k < 3; ++k) {
       const auto v = static_cast<size_t>(triangles[static_cast<size_t>(queue[q])][k]);
@@ -330,38 +397,135 @@ Eigen::VectorXd local_geodesic_distance(const std::vector<Eigen::Vector3d>& posi
     }
   }
   if (10 * queue.size() > 7 * nt) {
-    return HeatGeodesics(positions, triangles, name).distance(source);
+    part.whole = true;
+    part.triangles.resize(nt);
+    std::iota(part.triangles.begin(), part.triangles.end(), 0);
+    part.global.resize(nv);
+    std::iota(part.global.begin(), part.global.end(), 0);
+    return part;
   }
   // The part as a mesh of its own, in the whole mesh's triangle order.
   std::sort(queue.begin(), queue.end());
-  std::vector<int> local(nv, -1), global;
-  std::vector<Eigen::Vector3d> part_positions;
-  std::vector<Eigen::Vector3i> part_triangles;
-  part_triangles.reserve(queue.size());
-  MeshLocation part_source = source;
+  std::vector<int> local(nv, -1);
+  part.local.reserve(queue.size());
   for (const int t : queue) {
     Eigen::Vector3i tri;
     for (int k = 0; k < 3; ++k) {
       const auto v = static_cast<size_t>(triangles[static_cast<size_t>(t)][k]);
       if (local[v] < 0) {
-        local[v] = static_cast<int>(global.size());
-        global.push_back(static_cast<int>(v));
-        part_positions.push_back(positions[v]);
+        local[v] = static_cast<int>(part.global.size());
+        part.global.push_back(static_cast<int>(v));
+        part.positions.push_back(positions[v]);
       }
       tri[k] = local[v];
     }
-    if (t == source.triangle) {
-      part_source.triangle = static_cast<int>(part_triangles.size());
-    }
-    part_triangles.push_back(tri);
+    part.local.push_back(tri);
   }
-  const Eigen::VectorXd part =
-      HeatGeodesics(part_positions, part_triangles, name).distance(part_source);
+  return part;
+}
+
+Eigen::Vector3d point_of(const std::vector<Eigen::Vector3d>& positions,
+                         const std::vector<Eigen::Vector3i>& triangles, const MeshLocation& p) {
+  const Eigen::Vector3i& home = triangles[static_cast<size_t>(p.triangle)];
+  return p.bary[0] * positions[static_cast<size_t>(home[0])] +
+         p.bary[1] * positions[static_cast<size_t>(home[1])] +
+         p.bary[2] * positions[static_cast<size_t>(home[2])];
+}
+
+/// The source in the part's own triangles (the part's triangles are increasing mesh triangles).
+MeshLocation source_in(const Part& part, const MeshLocation& source) {
+  MeshLocation s = source;
+  const auto found = std::lower_bound(part.triangles.begin(), part.triangles.end(), s.triangle);
+  s.triangle = static_cast<int>(found - part.triangles.begin());
+  return s;
+}
+
+Eigen::VectorXd spread(const Part& part, const Eigen::VectorXd& on_part, size_t nv, double far) {
   Eigen::VectorXd distance = Eigen::VectorXd::Constant(static_cast<Eigen::Index>(nv), far);
-  for (size_t i = 0; i < global.size(); ++i) {
-    distance[global[i]] = part[static_cast<Eigen::Index>(i)];
+  for (size_t i = 0; i < part.global.size(); ++i) {
+    distance[part.global[i]] = on_part[static_cast<Eigen::Index>(i)];
   }
   return distance;
+}
+
+}  // namespace
+
+Eigen::VectorXd local_geodesic_distance(const std::vector<Eigen::Vector3d>& positions,
+                                        const std::vector<Eigen::Vector3i>& triangles,
+                                        const MeshLocation& source, double reach, double far,
+                                        const std::string& name) {
+  const Part part = select_part(positions, triangles, point_of(positions, triangles, source),
+                                source.triangle, 2.0 * reach);
+  if (part.whole) {
+    return HeatGeodesics(positions, triangles, name).distance(source);
+  }
+  return spread(part,
+                HeatGeodesics(part.positions, part.local, name).distance(source_in(part, source)),
+                positions.size(), far);
+}
+
+struct LocalHeatCache::Held {
+  Eigen::Vector3d centre;  // the part holds the triangles within 2 reach of it
+  double reach = 0.0;
+  size_t nv = 0, nt = 0;  // of the mesh
+  Part part;
+  std::unique_ptr<HeatGeodesics> heat;  // on the part (or the mesh, part.whole)
+
+  // Whether the part is still the mesh's (the same vertices at the same places and triangles).
+  bool matches(const std::vector<Eigen::Vector3d>& positions,
+               const std::vector<Eigen::Vector3i>& triangles) const {
+    if (positions.size() != nv || triangles.size() != nt) {
+      return false;
+    }
+    for (size_t i = 0; i < part.global.size(); ++i) {
+      if (positions[static_cast<size_t>(part.global[i])] != part.positions[i]) {
+        return false;
+      }
+    }
+    for (size_t t = 0; t < part.triangles.size(); ++t) {
+      const Eigen::Vector3i& mesh = triangles[static_cast<size_t>(part.triangles[t])];
+      const Eigen::Vector3i& local = part.local[t];
+      for (int k = 0; k < 3; ++k) {
+        if (part.global[static_cast<size_t>(local[k])] != mesh[k]) {
+          return false;
+        }
+      }
+    }
+    return true;
+  }
+};
+
+LocalHeatCache::LocalHeatCache() = default;
+LocalHeatCache::~LocalHeatCache() = default;
+
+Eigen::VectorXd LocalHeatCache::distance(const std::vector<Eigen::Vector3d>& positions,
+                                         const std::vector<Eigen::Vector3i>& triangles,
+                                         const MeshLocation& source, double reach, double far,
+                                         const std::string& name) {
+  const Eigen::Vector3d centre = point_of(positions, triangles, source);
+  const auto holds = [&](const Held& h) {
+    return !h.part.whole && (centre - h.centre).norm() + 2.0 * reach <= 2.0 * h.reach &&
+           h.reach <= kMaxRoom * reach &&
+           std::binary_search(h.part.triangles.begin(), h.part.triangles.end(), source.triangle) &&
+           h.matches(positions, triangles);
+  };
+  if (!held_ || !holds(*held_)) {
+    held_.reset();
+    auto h = std::make_unique<Held>();
+    h->centre = centre;
+    h->reach = kRoom * reach;
+    h->nv = positions.size();
+    h->nt = triangles.size();
+    h->part = select_part(positions, triangles, centre, source.triangle, 2.0 * h->reach);
+    if (h->part.whole) {
+      return local_geodesic_distance(positions, triangles, source, reach, far, name);
+    }
+    h->heat = std::make_unique<HeatGeodesics>(h->part.positions, h->part.local, name);
+    held_ = std::move(h);
+    ++builds_;
+  }
+  return spread(held_->part, held_->heat->distance_reusing(source_in(held_->part, source)),
+                positions.size(), far);
 }
 
 }  // namespace elastic::regions_detail

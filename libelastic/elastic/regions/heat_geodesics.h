@@ -40,8 +40,12 @@ class HeatGeodesics {
   /// Heat u after one step from a point source.
   /// \throws NumericalError when the factorisation of the heat operator fails.
   Eigen::VectorXd heat(const MeshLocation& source) const;
-  /// Approximate geodesic distance from the source to every vertex.
+  /// Approximate geodesic distance from the source to every vertex. Each call factors the Poisson
+  /// operator pinned at the source's corner.
   Eigen::VectorXd distance(const MeshLocation& source) const;
+  /// The same distance (to round-off) with the Poisson operator factored on the first call only,
+  /// for many sources on one mesh: two more back-substitutions per call instead of a factorisation.
+  Eigen::VectorXd distance_reusing(const MeshLocation& source) const;
 
   double mean_edge_length() const { return h_; }
 
@@ -50,6 +54,10 @@ class HeatGeodesics {
   Eigen::VectorXd divergence(const Eigen::VectorXd& u) const;
   Eigen::SparseMatrix<double> pinned_laplacian(int pin) const;
   void factor_heat() const;
+  void factor_poisson() const;
+  int pin_of(const MeshLocation& source) const;
+  /// phi shifted to vanish at the source and by the heat step's offset (distance()).
+  Eigen::VectorXd shifted_to_source(Eigen::VectorXd phi, const MeshLocation& source) const;
 
   const std::vector<Eigen::Vector3d>& x_;
   const std::vector<Eigen::Vector3i>& tri_;
@@ -59,6 +67,9 @@ class HeatGeodesics {
   Eigen::VectorXd mass_;                   // lumped (barycentric) mass per vertex
   mutable std::once_flag heat_factored_;
   mutable std::unique_ptr<Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>>> heat_solver_;
+  mutable std::once_flag poisson_factored_;
+  mutable std::unique_ptr<Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>>> poisson_solver_;
+  mutable Eigen::VectorXd poisson_w0_;  // A^-1 e_0 (distance_reusing)
 };
 
 /// Heat-method distance from `source` that is exact (up to the method's own error) at every vertex
@@ -75,5 +86,38 @@ Eigen::VectorXd local_geodesic_distance(const std::vector<Eigen::Vector3d>& posi
                                         const std::vector<Eigen::Vector3i>& triangles,
                                         const MeshLocation& source, double reach, double far,
                                         const std::string& name);
+
+/// local_geodesic_distance for many sources near each other (a disk dragged in small steps): the
+/// part of the mesh within 2 kRoom `reach` of the first source, and its heat method with both
+/// factorisations (HeatGeodesics::distance_reusing), are kept and reused while a later source's
+/// ball of 2 `reach` lies inside that part's ball and its reach is at least 1 / kMaxRoom of the
+/// kept one; otherwise they are built again around the new source. The distance differs from
+/// local_geodesic_distance's within the heat method's own error (the part is larger, and its
+/// boundary condition further away). A part that would be most of the mesh is not kept. Not
+/// thread-safe.
+class LocalHeatCache {
+ public:
+  static constexpr double kRoom = 1.25;
+  static constexpr double kMaxRoom = 2.0;
+
+  LocalHeatCache();
+  ~LocalHeatCache();
+  LocalHeatCache(const LocalHeatCache&) = delete;
+  LocalHeatCache& operator=(const LocalHeatCache&) = delete;
+
+  /// As local_geodesic_distance. The kept part is checked against the mesh at every call (its
+  /// vertices' positions and its triangles), so a changed mesh rebuilds it.
+  Eigen::VectorXd distance(const std::vector<Eigen::Vector3d>& positions,
+                           const std::vector<Eigen::Vector3i>& triangles,
+                           const MeshLocation& source, double reach, double far,
+                           const std::string& name);
+  /// How many parts were built (and their heat operators factored) so far.
+  long builds() const { return builds_; }
+
+ private:
+  struct Held;
+  std::unique_ptr<Held> held_;
+  long builds_ = 0;
+};
 
 }  // namespace elastic::regions_detail

@@ -12,7 +12,16 @@
 
 #include "elastic/projection/closest_point.h"
 #include "elastic/regions/cut_mesh.h"
+#include "elastic/regions/heat_geodesics.h"
 #include "elastic/regions/region_spec.h"
+
+namespace elastic {
+
+struct RegionCache::Impl {
+  regions_detail::LocalHeatCache disk_distance;  ///< `disk:` (disk_region.cpp)
+};
+
+}  // namespace elastic
 
 namespace elastic::regions_detail {
 

@@ -92,6 +92,12 @@ void throw_not_disk(const std::string& name) {
 }  // namespace elastic::regions_detail
 
 namespace elastic {
+
+RegionCache::RegionCache() : impl_(std::make_unique<Impl>()) {}
+RegionCache::~RegionCache() = default;
+RegionCache::RegionCache(RegionCache&&) noexcept = default;
+RegionCache& RegionCache::operator=(RegionCache&&) noexcept = default;
+
 namespace {
 
 using regions_detail::Chart;

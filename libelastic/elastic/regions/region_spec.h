@@ -19,11 +19,12 @@
 /// automatically (see make_region).
 ///
 /// The region is cut out of the projector's tessellation along the curve exactly (docs/regions.md):
-/// `disk` distances come from the heat method (Crane et al. 2013), `points` are joined by paths
-/// traced up the heat gradient (approximate geodesics, within about one tessellation edge), `uv`
-/// polygon edges are straight in texture space.
+/// `disk` distances come from the heat method (Crane et al. 2013), `points` are joined by exact
+/// shortest paths on the tessellation (CGAL's, regions/polygon_sides.h), `uv` polygon edges are
+/// straight in texture space.
 
 #include <Eigen/Core>
+#include <memory>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -50,6 +51,26 @@ struct RegionSpec {
 /// Reads FILE for points: and uv:. \throws InvalidInputError / IoError naming the flag or the file.
 RegionSpec parse_region_spec(std::string_view text, std::string_view flag = "region");
 
+/// What make_region may keep from one call to the next for speed (RegionOptions::cache): the heat
+/// method's two factorisations on a `disk:`'s neighbourhood, somewhat larger than the disk needs,
+/// reused while later disks on the same tessellation fit inside it (a disk dragged in small steps:
+/// the live re-solve of `elastic studio`). A disk cut with a cache can differ from the same disk
+/// cut without one within the heat method's error (about one tessellation edge on its boundary),
+/// so cut a result that must repeat from its spec without one. Not thread-safe: one per caller.
+class RegionCache {
+ public:
+  RegionCache();
+  ~RegionCache();
+  RegionCache(RegionCache&&) noexcept;
+  RegionCache& operator=(RegionCache&&) noexcept;
+
+  struct Impl;  ///< internal (regions/region_context.h)
+  Impl& impl() { return *impl_; }
+
+ private:
+  std::unique_ptr<Impl> impl_;
+};
+
 struct RegionOptions {
   /// A spec point farther from the surface than this fraction of the surface's bounding-box
   /// diagonal is an error ("point is far from the surface").
@@ -62,6 +83,8 @@ struct RegionOptions {
   /// tessellation of the same surface (within this budget) and its distance is interpolated; the
   /// disk is still cut on the full tessellation (docs/regions.md). 0: never.
   long max_heat_vertices = 150000;
+  /// Kept between calls (RegionCache), or none: every call computes afresh.
+  RegionCache* cache = nullptr;
 };
 
 /// Builds the region of `spec` on the projector's surface, boundary counter-clockwise seen from the
