@@ -16,6 +16,10 @@
 namespace elastic::regions_detail {
 namespace {
 
+/// A shift on the Poisson operator's diagonal that keeps the connected components not holding the
+/// pin non-singular.
+constexpr double kShift = 1e-12;
+
 // The cotangent Laplacian L (positive semi-definite, both triangles stored, columns sorted, every
 // diagonal entry present), the lumped (barycentric) mass per vertex and the mean edge length,
 // written straight into compressed columns: the 15 triplets per triangle and setFromTriplets they
@@ -182,10 +186,8 @@ Eigen::VectorXd HeatGeodesics::divergence(const Eigen::VectorXd& u) const {
 }
 
 Eigen::SparseMatrix<double> HeatGeodesics::pinned_laplacian(int pin) const {
-  // L without the pin's row and column (rows and columns past it move up by one), plus a tiny
-  // shift on the diagonal that keeps other connected components (not holding the pin)
-  // non-singular.
-  constexpr double kShift = 1e-12;
+  // L without the pin's row and column (rows and columns past it move up by one), plus kShift on
+  // the diagonal.
   const int nv = static_cast<int>(laplacian_.cols());
   const int* outer = laplacian_.outerIndexPtr();
   const int* inner = laplacian_.innerIndexPtr();
@@ -254,7 +256,6 @@ void HeatGeodesics::factor_poisson() const {
   std::call_once(poisson_factored_, [&] {
     // A = L + kShift I + e_0 e_0^T: the pinned operator's shift (pinned_laplacian) and a rank-one
     // term at vertex 0 that makes A positive definite on vertex 0's component.
-    constexpr double kShift = 1e-12;
     Eigen::SparseMatrix<double> a = laplacian_;
     for (int v = 0; v < a.cols(); ++v) {
       a.coeffRef(v, v) += v == 0 ? kShift + 1.0 : kShift;

@@ -18,7 +18,8 @@
 /// tip).
 ///
 /// Paths are not traced here: integral curves of grad u wind near the source (see
-/// exact_geodesics.h, which the `points:` sides use); the distance bounds their search band.
+/// exact_geodesics.h, which the `points:` sides use); the distance bounds the last band their
+/// search falls back to (polygon_sides.h).
 
 #include <Eigen/Core>
 #include <Eigen/SparseCholesky>

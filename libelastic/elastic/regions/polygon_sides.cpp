@@ -85,7 +85,7 @@ class SideBands {
 
   std::vector<char> heat(size_t i, size_t j) {
     if (!heat_) {
-      heat_ = std::make_unique<regions_detail::HeatGeodesics>(x_, triangles_, name_);
+      heat_ = std::make_unique<HeatGeodesics>(x_, triangles_, name_);
       dist_.resize(corners_.size());
     }
     for (const size_t k : {i, j}) {
@@ -93,8 +93,7 @@ class SideBands {
         dist_[k] = heat_->distance(corners_[k]);
       }
     }
-    return regions_detail::geodesic_band(triangles_, dist_[i], dist_[j], 0.5,
-                                         4.0 * heat_->mean_edge_length());
+    return geodesic_band(triangles_, dist_[i], dist_[j], 0.5, 4.0 * heat_->mean_edge_length());
   }
 
  private:
@@ -157,7 +156,7 @@ class SideBands {
   double cell_size_ = 1.0;
   std::vector<std::vector<int>> vertex_triangles_;
   std::unordered_map<std::uint64_t, std::vector<int>> cells_;
-  std::unique_ptr<regions_detail::HeatGeodesics> heat_;
+  std::unique_ptr<HeatGeodesics> heat_;
   std::vector<Eigen::VectorXd> dist_;
 };
 
