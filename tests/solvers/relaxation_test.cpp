@@ -41,9 +41,10 @@ RelaxationProblem make_problem(const ParticleGrid& grid, const Target& target,
     problem.initial_points.push_back(c.point);
   }
   problem.boundary_targets.resize(3, static_cast<Eigen::Index>(grid.boundary_loop.size()));
-  for (std::size_t k = 0; k < grid.boundary_loop.size(); ++k)
+  for (std::size_t k = 0; k < grid.boundary_loop.size(); ++k) {
     problem.boundary_targets.col(static_cast<Eigen::Index>(k)) =
         problem.initial_positions.col(grid.boundary_loop[k]);
+  }
   problem.rest_scale = 1.0;
   return problem;
 }
@@ -55,7 +56,9 @@ Eigen::Matrix3Xd perturb_interior(const ParticleGrid& grid, Eigen::Matrix3Xd x, 
   std::uniform_real_distribution<double> jitter(-amplitude, amplitude);
   for (int p = 0; p < grid.num_particles(); ++p) {
     const double dx = jitter(rng), dy = jitter(rng);
-    if (grid.is_boundary[static_cast<std::size_t>(p)]) continue;
+    if (grid.is_boundary[static_cast<std::size_t>(p)]) {
+      continue;
+    }
     x(0, p) += dx;
     x(1, p) += dy;
   }
@@ -170,7 +173,9 @@ class CylinderProblem {
   Eigen::Vector3d roll(double u, double z) const {
     const double a = middle_ + u;
     std::size_t k = 0;
-    while (k + 2 < arc_.size() && arc_[k + 1] < a) ++k;
+    while (k + 2 < arc_.size() && arc_[k + 1] < a) {
+      ++k;
+    }
     const double t = (a - arc_[k]) / (arc_[k + 1] - arc_[k]);
     Eigen::Vector3d p = (1.0 - t) * curve_[k] + t * curve_[k + 1];
     p.z() = z;
@@ -179,7 +184,9 @@ class CylinderProblem {
 
   Eigen::Matrix3Xd roll(const Eigen::Matrix3Xd& plane) const {
     Eigen::Matrix3Xd x(3, plane.cols());
-    for (Eigen::Index p = 0; p < plane.cols(); ++p) x.col(p) = roll(plane(0, p), plane(1, p));
+    for (Eigen::Index p = 0; p < plane.cols(); ++p) {
+      x.col(p) = roll(plane(0, p), plane(1, p));
+    }
     return x;
   }
 
@@ -193,7 +200,9 @@ class CylinderProblem {
 // RMS relative length distortion sqrt(E_len / (C sum k^2)) of a result.
 double rms_length_distortion(const ParticleGrid& grid, const RelaxationResult& result) {
   double sum = 0.0;
-  for (const Spring& s : grid.springs) sum += s.rest * s.rest;
+  for (const Spring& s : grid.springs) {
+    sum += s.rest * s.rest;
+  }
   return std::sqrt(result.length_energy / sum);
 }
 
@@ -419,27 +428,35 @@ TEST(Relaxation, InteriorLaplacianIsTheQuadraticFormOfTheSprings) {
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   for (int trial = 0; trial < 3; ++trial) {
     Eigen::VectorXd v(setup.num_free());
-    for (Eigen::Index k = 0; k < v.size(); ++k) v[k] = u(rng);
+    for (Eigen::Index k = 0; k < v.size(); ++k) {
+      v[k] = u(rng);
+    }
     const auto value = [&](int p) {
       const int k = setup.interior_index[static_cast<std::size_t>(p)];
       return k < 0 ? 0.0 : v[k];
     };
     double form = 0.0;
-    for (const Spring& s : grid.springs)
+    for (const Spring& s : grid.springs) {
       form += options.stiffness * std::pow(value(s.i) - value(s.j), 2);
-    for (const AngularSpring& s : grid.angular_springs)
+    }
+    for (const AngularSpring& s : grid.angular_springs) {
       form +=
           *options.angular_stiffness * std::pow(value(s.i) - 0.5 * (value(s.a) + value(s.b)), 2);
+    }
     // v^T L v from the lower triangle: diagonal once, off-diagonal entries twice.
     double quadratic = 0.0;
-    for (Eigen::Index c = 0; c < lower.outerSize(); ++c)
-      for (Eigen::SparseMatrix<double>::InnerIterator it(lower, c); it; ++it)
+    for (Eigen::Index c = 0; c < lower.outerSize(); ++c) {
+      for (Eigen::SparseMatrix<double>::InnerIterator it(lower, c); it; ++it) {
         quadratic += (it.row() == it.col() ? 1.0 : 2.0) * it.value() * v[it.row()] * v[it.col()];
+      }
+    }
     EXPECT_NEAR(quadratic, 2.0 * form, 1e-12 * form);
   }
-  for (Eigen::Index k = 0; k < lower.outerSize(); ++k)
-    for (Eigen::SparseMatrix<double>::InnerIterator it(lower, k); it; ++it)
+  for (Eigen::Index k = 0; k < lower.outerSize(); ++k) {
+    for (Eigen::SparseMatrix<double>::InnerIterator it(lower, k); it; ++it) {
       EXPECT_GE(it.row(), it.col()) << "only the lower triangle is stored";
+    }
+  }
 }
 
 }  // namespace
