@@ -276,8 +276,9 @@ TEST(Cli, ForcedFailureHasOneVerdictAcrossMapCompareAndPaste) {
 }
 
 // `bench warm` on a small drag (the command, not its figures): one cold first map, then every step
-// mapped cold and warm, the warm ones converged fold-free to the cold ones' energy (2%); a region
-// that is not a disk cannot be dragged.
+// mapped cold and warm, the warm ones converged fold-free to the cold ones' energy (2%), and each
+// disk cut again with the drag's RegionCache to within 2% of its fresh area; a region that is not a
+// disk cannot be dragged.
 TEST(Cli, BenchWarmMapsEveryStepColdAndWarm) {
   const fs::path dir = test::scratch_dir("cli_bench_warm");
   const CliRun run = elastic(
@@ -295,6 +296,8 @@ TEST(Cli, BenchWarmMapsEveryStepColdAndWarm) {
     EXPECT_NEAR(warm["energy"].get<double>(), steps[k]["cold"]["energy"].get<double>(),
                 0.02 * steps[k]["cold"]["energy"].get<double>());
     EXPECT_NE(steps[k]["region"], steps[k - 1]["region"]);  // the disk did move
+    EXPECT_NEAR(steps[k]["cached_area_ratio"].get<double>(), 1.0, 0.02) << steps[k].dump();
+    EXPECT_GT(steps[k]["seconds_region_cached"].get<double>(), 0.0);
   }
   expect_error(elastic("bench warm -q --target-region boundary", dir), 65, "disk");
 }
