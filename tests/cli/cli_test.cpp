@@ -359,7 +359,9 @@ TEST(Cli, BenchRobustnessReportsEveryCaseWithItsVerdict) {
   ASSERT_EQ(run.code, 0) << run.err;
   const nlohmann::json report = nlohmann::json::parse(std::ifstream(dir / "r.json"));
   ASSERT_EQ(report["cases"].size(), 2u);
-  for (const auto& c : report["cases"]) EXPECT_TRUE(c["pass"].is_boolean()) << c.dump();
+  for (const auto& c : report["cases"]) {
+    EXPECT_TRUE(c["pass"].is_boolean()) << c.dump();
+  }
 
   const nlohmann::json& ok = report["cases"][0];
   ASSERT_FALSE(ok.contains("error")) << ok.dump();
@@ -367,7 +369,9 @@ TEST(Cli, BenchRobustnessReportsEveryCaseWithItsVerdict) {
   double best_sd = INFINITY, best_len = INFINITY;
   for (const char* name : {"lscm", "arap", "dcm"}) {
     const nlohmann::json& m = ok["methods"][name];
-    if (m.contains("error") || m["folds"] != 0 || m["outside"] != 0) continue;
+    if (m.contains("error") || m["folds"] != 0 || m["outside"] != 0) {
+      continue;
+    }
     best_sd = std::min(best_sd, m["symmetric_dirichlet"].get<double>());
     best_len = std::min(best_len, m["length_energy"].get<double>());
   }
