@@ -32,6 +32,16 @@ struct MeshLocation {
   Eigen::Vector3d bary = Eigen::Vector3d(1.0, 0.0, 0.0);
 };
 
+/// The 3D point of a location on the mesh with these positions and triangles.
+inline Eigen::Vector3d position_of(const std::vector<Eigen::Vector3d>& positions,
+                                   const std::vector<Eigen::Vector3i>& triangles,
+                                   const MeshLocation& p) {
+  const Eigen::Vector3i& c = triangles[static_cast<size_t>(p.triangle)];
+  return p.bary[0] * positions[static_cast<size_t>(c[0])] +
+         p.bary[1] * positions[static_cast<size_t>(c[1])] +
+         p.bary[2] * positions[static_cast<size_t>(c[2])];
+}
+
 /// The corners' (u, v) of every tessellation triangle in its own ptex face. A vertex welded on a
 /// ptex edge carries the (u, v) of one adjacent face only; for the other faces its coordinates are
 /// found among the face's boundary grid nodes (the tessellation is a uniform grid per face) as the

@@ -393,10 +393,7 @@ struct FaceLocator {
 Eigen::VectorXd disk_distance(const RegionContext& ctx, const MeshLocation& centre, double radius) {
   const std::string& name = ctx.options.name;
   const LimitTessellation& tess = ctx.tess;
-  const Eigen::Vector3i& home = tess.triangles[static_cast<size_t>(centre.triangle)];
-  const Eigen::Vector3d at = centre.bary[0] * tess.positions[static_cast<size_t>(home[0])] +
-                             centre.bary[1] * tess.positions[static_cast<size_t>(home[1])] +
-                             centre.bary[2] * tess.positions[static_cast<size_t>(home[2])];
+  const Eigen::Vector3d at = position_of(tess.positions, tess.triangles, centre);
   const auto within = [&](int v) {
     return (tess.positions[static_cast<size_t>(v)] - at).squaredNorm() <= 4.0 * radius * radius;
   };

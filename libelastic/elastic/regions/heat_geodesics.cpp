@@ -312,11 +312,7 @@ Eigen::VectorXd HeatGeodesics::shifted_to_source(Eigen::VectorXd phi,
   // distance equals the chord length to third order (their difference is about k^2 d^3 / 24 for
   // curvature k), so the shift is measured as the median of phi - |x - source| over the vertices
   // between 3 and 6 mean edge lengths from the source, and removed.
-  Eigen::Vector3d centre = Eigen::Vector3d::Zero();
-  for (int k = 0; k < 3; ++k) {
-    centre +=
-        source.bary[k] * x_[static_cast<size_t>(tri_[static_cast<size_t>(source.triangle)][k])];
-  }
+  const Eigen::Vector3d centre = position_of(x_, tri_, source);
   std::vector<double> offsets;
   for (int i = 0; i < nv; ++i) {
     const double chord = (x_[static_cast<size_t>(i)] - centre).norm();
@@ -425,14 +421,6 @@ Part select_part(const std::vector<Eigen::Vector3d>& positions,
   return part;
 }
 
-Eigen::Vector3d point_of(const std::vector<Eigen::Vector3d>& positions,
-                         const std::vector<Eigen::Vector3i>& triangles, const MeshLocation& p) {
-  const Eigen::Vector3i& home = triangles[static_cast<size_t>(p.triangle)];
-  return p.bary[0] * positions[static_cast<size_t>(home[0])] +
-         p.bary[1] * positions[static_cast<size_t>(home[1])] +
-         p.bary[2] * positions[static_cast<size_t>(home[2])];
-}
-
 /// The source in the part's own triangles (the part's triangles are increasing mesh triangles).
 MeshLocation source_in(const Part& part, const MeshLocation& source) {
   MeshLocation s = source;
@@ -455,7 +443,7 @@ Eigen::VectorXd local_geodesic_distance(const std::vector<Eigen::Vector3d>& posi
                                         const std::vector<Eigen::Vector3i>& triangles,
                                         const MeshLocation& source, double reach, double far,
                                         const std::string& name) {
-  const Part part = select_part(positions, triangles, point_of(positions, triangles, source),
+  const Part part = select_part(positions, triangles, position_of(positions, triangles, source),
                                 source.triangle, 2.0 * reach);
   if (part.whole) {
     return HeatGeodesics(positions, triangles, name).distance(source);
@@ -503,7 +491,7 @@ Eigen::VectorXd LocalHeatCache::distance(const std::vector<Eigen::Vector3d>& pos
                                          const std::vector<Eigen::Vector3i>& triangles,
                                          const MeshLocation& source, double reach, double far,
                                          const std::string& name) {
-  const Eigen::Vector3d centre = point_of(positions, triangles, source);
+  const Eigen::Vector3d centre = position_of(positions, triangles, source);
   const auto holds = [&](const Held& h) {
     return !h.part.whole && (centre - h.centre).norm() + 2.0 * reach <= 2.0 * h.reach &&
            h.reach <= kMaxRoom * reach &&
@@ -519,7 +507,7 @@ Eigen::VectorXd LocalHeatCache::distance(const std::vector<Eigen::Vector3d>& pos
     h->nt = triangles.size();
     h->part = select_part(positions, triangles, centre, source.triangle, 2.0 * h->reach);
     if (h->part.whole) {
-      return local_geodesic_distance(positions, triangles, source, reach, far, name);
+      return HeatGeodesics(positions, triangles, name).distance(source);
     }
     h->heat = std::make_unique<HeatGeodesics>(h->part.positions, h->part.local, name);
     held_ = std::move(h);

@@ -25,11 +25,7 @@ class SideBands {
             const std::string& name)
       : x_(positions), triangles_(triangles), corners_(corners), name_(name) {
     for (const MeshLocation& c : corners) {
-      Eigen::Vector3d p = Eigen::Vector3d::Zero();
-      for (int k = 0; k < 3; ++k) {
-        p += c.bary[k] * x_[static_cast<size_t>(triangles_[static_cast<size_t>(c.triangle)][k])];
-      }
-      where_.push_back(p);
+      where_.push_back(position_of(x_, triangles_, c));
     }
     index_vertices();
   }

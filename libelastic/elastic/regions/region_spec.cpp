@@ -273,11 +273,7 @@ Region points_region(const Context& ctx, const RegionSpec& spec) {
   for (size_t i = 0; i < spec.points.size(); ++i) {
     const MeshLocation loc = ctx.project(spec.points[i], "point " + std::to_string(i + 1));
     // Drop repeated points (consecutive, or the last equal to the first).
-    Eigen::Vector3d x = Eigen::Vector3d::Zero();
-    for (int k = 0; k < 3; ++k) {
-      x += loc.bary[k] * ctx.tess.positions[static_cast<size_t>(
-                             ctx.tess.triangles[static_cast<size_t>(loc.triangle)][k])];
-    }
+    const Eigen::Vector3d x = position_of(ctx.tess.positions, ctx.tess.triangles, loc);
     if (!where.empty() && (x - where.back()).norm() <= 1e-9 * ctx.diagonal) {
       continue;
     }
