@@ -148,7 +148,8 @@ TEST(LocalGeodesics, CachedPartFollowsADraggedSource) {
 std::vector<regions_detail::SideBand> expect_sides_are_shortest(
     const Fixture& fx, const std::vector<Eigen::Vector3d>& polygon) {
   const LimitTessellation& tess = fx.projector->tessellation();
-  const regions_detail::RegionContext ctx(*fx.projector, {});
+  const RegionOptions options;
+  const regions_detail::RegionContext ctx(*fx.projector, options);
   std::vector<regions_detail::MeshLocation> corners;
   corners.reserve(polygon.size());
   for (const Eigen::Vector3d& x : polygon) {

@@ -40,6 +40,8 @@ struct RegionContext {
   double diagonal = 0.0;                         ///< of the tessellation's bounding box
 
   RegionContext(const SurfaceProjector& projector, const RegionOptions& options);
+  /// The context keeps a reference to the options: a temporary would dangle.
+  RegionContext(const SurfaceProjector& projector, RegionOptions&& options) = delete;
 
   /// The corners' (u, v) of every tessellation triangle (tessellation_corner_uv), computed the
   /// first time a whole-surface cut needs them; a disk cuts only its neighbourhood.
