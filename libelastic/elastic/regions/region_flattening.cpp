@@ -15,7 +15,6 @@
 #include "elastic/numerics/bicgstab.h"
 #include "elastic/numerics/graph_laplacian.h"
 #include "elastic/numerics/multigrid.h"
-#include "elastic/numerics/nested_dissection.h"
 
 namespace elastic {
 namespace {
@@ -343,47 +342,19 @@ Eigen::SparseMatrix<double> conformal_energy_form(const Region& region) {
   return full;
 }
 
-// The region's vertices in geometric nested-dissection order (numerics/nested_dissection.h), by
-// the graph of its triangles' edges.
-std::vector<int> dissection_order(const Region& region) {
-  const auto nv = static_cast<Eigen::Index>(region.positions.size());
-  Triplets edges;
-  edges.reserve(3 * region.triangles.size());
-  for (const Eigen::Vector3i& t : region.triangles) {
-    for (int k = 0; k < 3; ++k) {
-      const int a = t[k], b = t[(k + 1) % 3];
-      edges.emplace_back(std::max(a, b), std::min(a, b), 1.0);
-    }
-  }
-  Eigen::SparseMatrix<double> graph(nv, nv);
-  graph.setFromTriplets(edges.begin(), edges.end());
-  Eigen::Matrix3Xd xyz(3, nv);
-  for (Eigen::Index v = 0; v < nv; ++v) {
-    xyz.col(v) = region.positions[static_cast<size_t>(v)];
-  }
-  return nested_dissection_order(graph, xyz);
-}
-
-// Minimises x^T Q x with the first pin at (0, 0) and the second at (distance, 0). The unknowns are
-// numbered vertex by vertex in `order` (u, then v), and the factorisation keeps that order: on the
-// whole hemisphere's region (58,078 unknowns) geometric nested dissection fills about as much as
-// Eigen's AMD ordering (3.48 against 3.65 million entries in L) but its factorisation took 0.47 s
-// against 0.84 s (measured with a build beside it; CHOLMOD's supernodal factorisation with the
-// reference BLAS took 0.60 s on the same system).
+// Minimises x^T Q x with the first pin at (0, 0) and the second at (distance, 0).
 std::vector<Eigen::Vector2d> minimise_pinned(const Eigen::SparseMatrix<double>& full,
-                                             const ConformalPins& pins,
-                                             const std::vector<int>& order,
-                                             const std::string& name) {
+                                             const ConformalPins& pins, const std::string& name) {
   const auto unknowns = full.rows();
   const auto nv = static_cast<int>(unknowns / 2);
   std::vector<int> index(static_cast<size_t>(unknowns), -1);
   Eigen::VectorXd fixed = Eigen::VectorXd::Zero(unknowns);
   fixed[pins.second] = pins.distance;  // first pin at (0, 0), second at (d, 0)
   int free = 0;
-  for (const int v : order) {
+  for (int r = 0; r < 2 * nv; ++r) {
+    const int v = r % nv;
     if (v != pins.first && v != pins.second) {
-      index[static_cast<size_t>(v)] = free++;
-      index[static_cast<size_t>(v + nv)] = free++;
+      index[static_cast<size_t>(r)] = free++;
     }
   }
   Triplets reduced;
@@ -403,9 +374,7 @@ std::vector<Eigen::Vector2d> minimise_pinned(const Eigen::SparseMatrix<double>& 
   }
   Eigen::SparseMatrix<double> a(free, free);
   a.setFromTriplets(reduced.begin(), reduced.end());
-  const Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>, Eigen::Lower,
-                              Eigen::NaturalOrdering<int>>
-      solver(a);
+  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver(a);
   if (solver.info() != Eigen::Success) {
     throw NumericalError(name, "flattening: the LSCM system is singular");
   }
@@ -459,7 +428,7 @@ RegionFlattening flatten_conformal(const Region& region) {
           planar_coordinates(region, pins.first, pins.second)) {
     out.uv = std::move(*flat);
   } else {
-    out.uv = minimise_pinned(conformal_energy_form(region), pins, dissection_order(region), name);
+    out.uv = minimise_pinned(conformal_energy_form(region), pins, name);
     scale_to_area(region, out.uv);
   }
   out.folded_triangles = count_folds(region, out.uv);

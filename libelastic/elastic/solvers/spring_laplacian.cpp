@@ -11,7 +11,7 @@
 
 #include "elastic/core/error.h"
 #include "elastic/core/huge_pages.h"
-#include "elastic/numerics/nested_dissection.h"
+#include "elastic/solvers/nested_dissection.h"
 #include "elastic/solvers/solver_common.h"
 
 namespace elastic::solver_detail {

@@ -1,17 +1,16 @@
 #pragma once
 /// \file
-/// Geometric nested dissection: the fill-reducing ordering of sparse factorisations on meshes and
-/// particle grids whose unknowns have positions: the spring Laplacian's (solvers/spring_laplacian.h)
-/// and the least-squares conformal flattening's (regions/region_flattening.h).
+/// Geometric nested dissection: the fill-reducing ordering of the spring Laplacian's
+/// factorisation (spring_laplacian.h). Internal to the solvers (solver_detail).
 
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
 #include <vector>
 
-namespace elastic {
+namespace elastic::solver_detail {
 
-/// A fill-reducing ordering of the nodes (interior particles, mesh vertices) by geometric nested
-/// dissection: the particles (columns of `coordinates`, n = laplacian.rows()) are split at the median of the
+/// A fill-reducing ordering of the interior particles by geometric nested dissection: the
+/// particles (columns of `coordinates`, n = laplacian.rows()) are split at the median of the
 /// longest axis of their bounding box; the particles of the lower half that have a neighbour in the
 /// upper half (in the sparsity graph of `laplacian`, lower triangle stored) form the separator,
 /// numbered last; both halves are ordered recursively, down to leaves of 64 particles kept in their
@@ -22,4 +21,4 @@ namespace elastic {
 std::vector<int> nested_dissection_order(const Eigen::SparseMatrix<double>& laplacian,
                                          const Eigen::Matrix3Xd& coordinates);
 
-}  // namespace elastic
+}  // namespace elastic::solver_detail

@@ -1,4 +1,4 @@
-#include "elastic/numerics/nested_dissection.h"
+#include "elastic/solvers/nested_dissection.h"
 
 #include <Eigen/Core>
 #include <algorithm>
@@ -6,7 +6,7 @@
 #include <limits>
 #include <utility>
 
-namespace elastic {
+namespace elastic::solver_detail {
 
 namespace {
 
@@ -114,4 +114,4 @@ std::vector<int> nested_dissection_order(const Eigen::SparseMatrix<double>& lapl
   return order;
 }
 
-}  // namespace elastic
+}  // namespace elastic::solver_detail
