@@ -1,5 +1,8 @@
-// Geometric nested dissection (solvers/nested_dissection.h), the direct H0's order, on a grid, where the answer is known:
-// a permutation whose last block is a separator, and O(n log n) fill against the band's n^1.5.
+// Geometric nested dissection (solvers/nested_dissection.h), the direct H0's order, on a grid,
+// where the answer is known: a permutation whose last block is a separator, and O(n log n) fill
+// against the band's n^1.5.
+#include "elastic/solvers/nested_dissection.h"
+
 #include <gtest/gtest.h>
 
 #include <Eigen/OrderingMethods>
@@ -7,8 +10,6 @@
 #include <algorithm>
 #include <numeric>
 #include <vector>
-
-#include "elastic/solvers/nested_dissection.h"
 
 namespace elastic {
 namespace {
@@ -24,7 +25,8 @@ struct Grid {
 };
 
 Grid make_grid(int k) {
-  Grid g{k, Eigen::SparseMatrix<double>(k * k, k * k), Eigen::Matrix3Xd(3, k * k)};
+  const Eigen::Index n = Eigen::Index{k} * k;
+  Grid g{k, Eigen::SparseMatrix<double>(n, n), Eigen::Matrix3Xd(3, n)};
   std::vector<Eigen::Triplet<double>> t;
   for (int i = 0; i < k; ++i) {
     for (int j = 0; j < k; ++j) {
@@ -44,7 +46,8 @@ Grid make_grid(int k) {
 }
 
 /// Entries of L for the matrix factorised in the given order (order[p] = node at position p).
-Eigen::Index fill_in_order(const Eigen::SparseMatrix<double>& lower, const std::vector<int>& order) {
+Eigen::Index fill_in_order(const Eigen::SparseMatrix<double>& lower,
+                           const std::vector<int>& order) {
   Eigen::VectorXi position(static_cast<Eigen::Index>(order.size()));
   for (std::size_t p = 0; p < order.size(); ++p) {
     position[order[p]] = static_cast<int>(p);
