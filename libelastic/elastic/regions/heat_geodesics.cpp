@@ -8,7 +8,6 @@
 #include <cmath>
 #include <limits>
 #include <mutex>
-#include <numeric>
 
 #include "elastic/core/directed_edges.h"
 #include "elastic/core/error.h"
@@ -334,7 +333,8 @@ namespace {
 /// The part of the mesh local_geodesic_distance works on: the triangles with a corner within `ball`
 /// of the source point, connected to the source's triangle through them.
 struct Part {
-  bool whole = false;                      ///< more than 70% of the triangles: the whole mesh
+  bool whole = false;  ///< more than 70% of the triangles: use the whole mesh (the lists below are
+                       ///< then incomplete)
   std::vector<int> global;                 ///< part vertex -> mesh vertex
   std::vector<int> triangles;              ///< the mesh triangles in the part, increasing
   std::vector<Eigen::Vector3d> positions;  ///< of the part's vertices
@@ -394,11 +394,7 @@ Part select_part(const std::vector<Eigen::Vector3d>& positions,
     }
   }
   if (10 * queue.size() > 7 * nt) {
-    part.whole = true;
-    part.triangles.resize(nt);
-    std::iota(part.triangles.begin(), part.triangles.end(), 0);
-    part.global.resize(nv);
-    std::iota(part.global.begin(), part.global.end(), 0);
+    part.whole = true;  // the callers solve on the whole mesh: the lists are not needed
     return part;
   }
   // The part as a mesh of its own, in the whole mesh's triangle order.
