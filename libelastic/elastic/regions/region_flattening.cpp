@@ -8,6 +8,7 @@
 #include <Eigen/SparseLU>
 #include <algorithm>
 #include <cmath>
+#include <complex>
 #include <numbers>
 #include <optional>
 
@@ -281,11 +282,19 @@ ConformalPins conformal_pins(const Region& region) {
   return pins;
 }
 
-// The quadratic form x^T Q x of E_C = E_D - A over x = (u of every vertex, then v of every vertex).
-Eigen::SparseMatrix<double> conformal_energy_form(const Region& region) {
+using Complex = std::complex<double>;
+
+// The conformal energy E_C = E_D - A as a Hermitian form z^H H z over z = u + i v, one complex
+// unknown per vertex. The Dirichlet energy 1/2 sum_edges w_ij |z_i - z_j|^2 puts the cotangent
+// Laplacian in H's real part (the same matrix for u and for v, which is why one complex unknown
+// carries both). The signed area is 1/2 sum over boundary edges i -> j of
+// u_i v_j - u_j v_i = Im(conj(z_i) z_j), and -1/2 Im(w) = 2 Re(i/4 w), so -A puts i/4 at (i, j) and
+// -i/4 at (j, i). Against the real form over (u, v) of twice the size, the factorisation does about
+// half the arithmetic and keeps half the memory (its fill is the Laplacian's).
+Eigen::SparseMatrix<Complex> conformal_energy_form(const Region& region) {
   const int nv = region.num_vertices();
   const auto nb = static_cast<int>(region.boundary.size());
-  Triplets q;
+  std::vector<Eigen::Triplet<Complex>> h;
   for (const Eigen::Vector3i& t : region.triangles) {
     if (degenerate_in_3d(region, t)) {
       continue;  // no Dirichlet term and, below, no area term
@@ -300,24 +309,17 @@ Eigen::SparseMatrix<double> conformal_energy_form(const Region& region) {
       if (cross == 0.0) {
         continue;
       }
-      // Edge (i, j) opposite corner l: 1/2 cot(l) (|u_i - u_j|^2 + |v_i - v_j|^2) enters E_D with
-      // 1/2.
+      // Edge (i, j) opposite corner l: 1/2 cot(l) |z_i - z_j|^2 enters E_D with 1/2.
       const double w = 0.25 * a.dot(b) / cross;
-      for (int c = 0; c < 2; ++c) {
-        const int oi = i + c * nv, oj = j + c * nv;
-        q.emplace_back(oi, oi, w);
-        q.emplace_back(oj, oj, w);
-        q.emplace_back(oi, oj, -w);
-        q.emplace_back(oj, oi, -w);
-      }
+      h.emplace_back(i, i, w);
+      h.emplace_back(j, j, w);
+      h.emplace_back(i, j, -w);
+      h.emplace_back(j, i, -w);
     }
   }
-  // -A(u, v): -1/2 sum of (u_i v_j - u_j v_i) over directed edges i -> j, symmetrised.
   const auto add_area_edge = [&](int i, int j, double sign) {
-    q.emplace_back(i, j + nv, -0.25 * sign);
-    q.emplace_back(j + nv, i, -0.25 * sign);
-    q.emplace_back(j, i + nv, 0.25 * sign);
-    q.emplace_back(i + nv, j, 0.25 * sign);
+    h.emplace_back(i, j, Complex(0.0, 0.25 * sign));
+    h.emplace_back(j, i, Complex(0.0, -0.25 * sign));
   };
   for (int k = 0; k < nb; ++k) {
     add_area_edge(region.boundary[static_cast<size_t>(k)],
@@ -336,31 +338,31 @@ Eigen::SparseMatrix<double> conformal_energy_form(const Region& region) {
       }
     }
   }
-  const Eigen::Index unknowns = Eigen::Index{2} * nv;
-  Eigen::SparseMatrix<double> full(unknowns, unknowns);
-  full.setFromTriplets(q.begin(), q.end());
+  Eigen::SparseMatrix<Complex> full(nv, nv);
+  full.setFromTriplets(h.begin(), h.end());
   return full;
 }
 
-// Minimises x^T Q x with the first pin at (0, 0) and the second at (distance, 0).
-std::vector<Eigen::Vector2d> minimise_pinned(const Eigen::SparseMatrix<double>& full,
+// Minimises z^H H z with the first pin at 0 and the second at `distance` (on the real axis): the
+// free unknowns solve H_ff z_f = -H_fp z_p, Hermitian positive definite once two vertices are
+// pinned.
+std::vector<Eigen::Vector2d> minimise_pinned(const Eigen::SparseMatrix<Complex>& full,
                                              const ConformalPins& pins, const std::string& name) {
-  const auto unknowns = full.rows();
-  const auto nv = static_cast<int>(unknowns / 2);
-  std::vector<int> index(static_cast<size_t>(unknowns), -1);
-  Eigen::VectorXd fixed = Eigen::VectorXd::Zero(unknowns);
-  fixed[pins.second] = pins.distance;  // first pin at (0, 0), second at (d, 0)
+  const auto nv = static_cast<int>(full.rows());
+  std::vector<int> index(static_cast<size_t>(nv), -1);
+  Eigen::VectorXcd fixed = Eigen::VectorXcd::Zero(nv);
+  fixed[pins.second] = pins.distance;
   int free = 0;
-  for (int r = 0; r < 2 * nv; ++r) {
-    const int v = r % nv;
+  for (int v = 0; v < nv; ++v) {
     if (v != pins.first && v != pins.second) {
-      index[static_cast<size_t>(r)] = free++;
+      index[static_cast<size_t>(v)] = free++;
     }
   }
-  Triplets reduced;
-  Eigen::VectorXd rhs = Eigen::VectorXd::Zero(free);
+  std::vector<Eigen::Triplet<Complex>> reduced;
+  reduced.reserve(static_cast<size_t>(full.nonZeros()));
+  Eigen::VectorXcd rhs = Eigen::VectorXcd::Zero(free);
   for (int c = 0; c < full.outerSize(); ++c) {
-    for (Eigen::SparseMatrix<double>::InnerIterator it(full, c); it; ++it) {
+    for (Eigen::SparseMatrix<Complex>::InnerIterator it(full, c); it; ++it) {
       const int r = index[static_cast<size_t>(it.row())], cc = index[static_cast<size_t>(it.col())];
       if (r < 0) {
         continue;
@@ -372,23 +374,21 @@ std::vector<Eigen::Vector2d> minimise_pinned(const Eigen::SparseMatrix<double>& 
       }
     }
   }
-  Eigen::SparseMatrix<double> a(free, free);
+  Eigen::SparseMatrix<Complex> a(free, free);
   a.setFromTriplets(reduced.begin(), reduced.end());
-  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver(a);
+  Eigen::SimplicialLDLT<Eigen::SparseMatrix<Complex>> solver(a);
   if (solver.info() != Eigen::Success) {
     throw NumericalError(name, "flattening: the LSCM system is singular");
   }
-  const Eigen::VectorXd x = solver.solve(rhs);
+  const Eigen::VectorXcd x = solver.solve(rhs);
   if (solver.info() != Eigen::Success || !x.allFinite()) {
     throw NumericalError(name, "flattening: the LSCM solve failed");
   }
   std::vector<Eigen::Vector2d> uv(static_cast<size_t>(nv));
   for (int v = 0; v < nv; ++v) {
-    for (int c = 0; c < 2; ++c) {
-      const int r = v + c * nv;
-      uv[static_cast<size_t>(v)][c] =
-          index[static_cast<size_t>(r)] >= 0 ? x[index[static_cast<size_t>(r)]] : fixed[r];
-    }
+    const int r = index[static_cast<size_t>(v)];
+    const Complex z = r >= 0 ? x[r] : fixed[v];
+    uv[static_cast<size_t>(v)] = Eigen::Vector2d(z.real(), z.imag());
   }
   return uv;
 }
