@@ -1,6 +1,7 @@
 #include "elastic/mapping/map_regions.h"
 
 #include <tbb/parallel_invoke.h>
+#include <tbb/task_group.h>
 
 #include <chrono>
 #include <optional>
@@ -107,15 +108,21 @@ bool uses_coarse_start(const MapOptions& options, const ParticleGrid& grid) {
          options.sampling.layout.particles / options.coarse_start_ratio >= 16;
 }
 
+// The two regions' disk maps (the naive map's, Fig. 9a); a multilevel start's top level hands its
+// own to the coarse level, which returns them in its result.
+struct DiskMaps {
+  std::unique_ptr<RegionDiskMap> source, target;
+};
+
 MapResult map_cold(const SurfaceProjector& source, const Region& source_region,
                    const SurfaceProjector& target, const Region& target_region,
-                   const MapOptions& options, bool top);
+                   const MapOptions& options, bool top, DiskMaps disks);
 
 // The coarse map of a multilevel start: the same job with 1/ratio of the particles, its stages
 // reported as "coarse <stage>" and no animation frames (they would have the coarse grid's size).
 MapResult coarse_map(const SurfaceProjector& source, const Region& source_region,
                      const SurfaceProjector& target, const Region& target_region,
-                     const MapOptions& options) {
+                     const MapOptions& options, DiskMaps disks) {
   MapOptions coarse = options;
   coarse.sampling.layout.particles = options.sampling.layout.particles / options.coarse_start_ratio;
   coarse.relaxation.frame = nullptr;
@@ -132,7 +139,8 @@ MapResult coarse_map(const SurfaceProjector& source, const Region& source_region
   };
   coarse.progress = prefixed(options.progress);
   coarse.relaxation.progress = prefixed(options.relaxation.progress);
-  return map_cold(source, source_region, target, target_region, coarse, /*top=*/false);
+  return map_cold(source, source_region, target, target_region, coarse, /*top=*/false,
+                  std::move(disks));
 }
 
 // Starts `problem` (the naive map's) from the coarse map carried onto `grid` (prolonged_map) and
@@ -299,10 +307,11 @@ void subdivide(const SurfaceProjector& source, const SurfaceProjector& target,
   result.seconds_subdivision = seconds_since(start);
 }
 
-// The cold map; `top`: the grid the caller asked for (not a multilevel start's coarse level).
+// The cold map; `top`: the grid the caller asked for (not a multilevel start's coarse level);
+// `disks`: the regions' disk maps when the caller has them (else built here).
 MapResult map_cold(const SurfaceProjector& source, const Region& source_region,
                    const SurfaceProjector& target, const Region& target_region,
-                   const MapOptions& options, bool top) {
+                   const MapOptions& options, bool top, DiskMaps disks) {
   check_options(options);
   auto stage = [&](std::string_view name) {
     if (!report_progress(options.progress, {.stage = name})) {
@@ -311,19 +320,42 @@ MapResult map_cold(const SurfaceProjector& source, const Region& source_region,
   };
   MapResult result;
 
-  // 1. Particles on the source (§4.1, §4.3).
+  // 1. Particles on the source (§4.1, §4.3). The two disk maps of step 2 depend only on the
+  // regions, so they are built beside the sampling, whose layout (a serial factorisation on a
+  // curved source) leaves a core free; the two are independent sparse solves, side by side too.
+  // The sampling stays on the calling thread, which reports its progress.
   stage("sample");
   auto start = std::chrono::steady_clock::now();
-  result.sampling = sample_region(source_region, source, options.sampling);
+  tbb::task_group disk_work;
+  if (!disks.source || !disks.target) {
+    disk_work.run([&] {
+      tbb::parallel_invoke([&] { disks.source = std::make_unique<RegionDiskMap>(source_region); },
+                           [&] { disks.target = std::make_unique<RegionDiskMap>(target_region); });
+    });
+  }
+  try {
+    result.sampling = sample_region(source_region, source, options.sampling);
+  } catch (...) {
+    disk_work.cancel();
+    try {
+      disk_work.wait();
+    } catch (...) {  // NOLINT(bugprone-empty-catch): the sampling's error is the one to report
+    }
+    throw;
+  }
   result.seconds_sampling = seconds_since(start);
+  start = std::chrono::steady_clock::now();
+  disk_work.wait();  // rethrows a disk map's error
+  const double seconds_disks = seconds_since(start);
   const ParticleGrid& grid = result.sampling.grid;
 
-  // 2a. The multilevel start's coarse map (MapOptions::coarse_start_above): its disk maps and
-  // boundary offset are this map's too.
+  // 2a. The multilevel start's coarse map (MapOptions::coarse_start_above) on these disk maps: its
+  // boundary offset is this map's too, and it returns the disk maps.
   std::optional<MapResult> coarse;
   if (uses_coarse_start(options, grid)) {
     start = std::chrono::steady_clock::now();
-    coarse.emplace(coarse_map(source, source_region, target, target_region, options));
+    coarse.emplace(
+        coarse_map(source, source_region, target, target_region, options, std::move(disks)));
     result.coarse_particles = coarse->sampling.grid.num_particles();
     result.coarse_iterations = coarse->relaxation.iterations + coarse->coarse_iterations;
     result.seconds_coarse = seconds_since(start);
@@ -336,10 +368,8 @@ MapResult map_cold(const SurfaceProjector& source, const Region& source_region,
     result.source_disk = std::move(coarse->source_disk);
     result.target_disk = std::move(coarse->target_disk);
   } else {
-    // The two disk maps are independent (a sparse solve each on its region): side by side.
-    tbb::parallel_invoke(
-        [&] { result.source_disk = std::make_unique<RegionDiskMap>(source_region); },
-        [&] { result.target_disk = std::make_unique<RegionDiskMap>(target_region); });
+    result.source_disk = std::move(disks.source);
+    result.target_disk = std::move(disks.target);
   }
 
   // 3. Rest scale sigma between the two regions' sizes.
@@ -351,7 +381,7 @@ MapResult map_cold(const SurfaceProjector& source, const Region& source_region,
     throw NumericalError("map", std::to_string(result.naive.outside) +
                                     " particles could not be placed in the target region");
   }
-  result.seconds_naive = seconds_since(start);
+  result.seconds_naive = seconds_disks + seconds_since(start);
 
   // 4. Relaxation on the target (§4.2, §4.4-4.6). Boundary particles stay at their arc-length
   // positions.
@@ -385,7 +415,7 @@ MapResult map_regions(const SurfaceProjector& source, const Region& source_regio
                       const SurfaceProjector& target, const Region& target_region,
                       const MapOptions& options) {
   check_surfaces(source, source_region, target, target_region);
-  return map_cold(source, source_region, target, target_region, options, /*top=*/true);
+  return map_cold(source, source_region, target, target_region, options, /*top=*/true, {});
 }
 
 MapResult map_regions(const SurfaceProjector& source, const Region& source_region,

@@ -112,8 +112,9 @@ struct MapResult {
   /// Faces the chosen offset's naive map folds (0 unless every candidate folds).
   int offset_folds = 0;
   double seconds_sampling = 0.0;  ///< source sampling (layout + adaptive sampling + springs)
-  double seconds_naive = 0.0;     ///< disk maps of both regions + naive placement
-  double seconds_mapping = 0.0;   ///< building the queryable mapping
+  double seconds_naive =
+      0.0;  ///< naive placement + the wait for the disk maps (built beside the sampling)
+  double seconds_mapping = 0.0;  ///< building the queryable mapping
   /// The multilevel start (MapOptions::coarse_start_above), when it ran: the coarse grid's
   /// particles, its L-BFGS iterations (the levels below it included) and its whole map's seconds
   /// (0 otherwise). `naive` is still the naive map of the grid (the distortion guard's yardstick).
