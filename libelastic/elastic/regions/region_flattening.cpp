@@ -285,16 +285,56 @@ ConformalPins conformal_pins(const Region& region) {
 using Complex = std::complex<double>;
 
 // The conformal energy E_C = E_D - A as a Hermitian form z^H H z over z = u + i v, one complex
-// unknown per vertex. The Dirichlet energy 1/2 sum_edges w_ij |z_i - z_j|^2 puts the cotangent
-// Laplacian in H's real part (the same matrix for u and for v, which is why one complex unknown
-// carries both). The signed area is 1/2 sum over boundary edges i -> j of
-// u_i v_j - u_j v_i = Im(conj(z_i) z_j), and -1/2 Im(w) = 2 Re(i/4 w), so -A puts i/4 at (i, j) and
-// -i/4 at (j, i). Against the real form over (u, v) of twice the size, the factorisation does about
-// half the arithmetic and keeps half the memory (its fill is the Laplacian's).
-Eigen::SparseMatrix<Complex> conformal_energy_form(const Region& region) {
+// unknown per vertex, with the first pin at 0 and the second at `distance` on the real axis. The
+// Dirichlet energy 1/2 sum_edges w_ij |z_i - z_j|^2 puts the cotangent Laplacian in H's real part
+// (the same matrix for u and for v, which is why one complex unknown carries both). The signed area
+// is 1/2 sum over boundary edges i -> j of u_i v_j - u_j v_i = Im(conj(z_i) z_j), and
+// -1/2 Im(w) = 2 Re(i/4 w), so -A puts i/4 at (i, j) and -i/4 at (j, i). Against the real form over
+// (u, v) of twice the size, the factorisation does about half the arithmetic and keeps half the
+// memory (its fill is the Laplacian's).
+//
+// The free unknowns minimise it where H_ff z_f = -H_fp z_p (Hermitian positive definite once two
+// vertices are pinned). Assembled straight into that system: the lower triangle of H_ff (all the
+// factorisation reads), the diagonal summed apart, and the pinned columns moved to the right side.
+struct PinnedConformalSystem {
+  std::vector<int> index;  ///< free unknown of each vertex, -1 for the pins
+  Eigen::VectorXcd fixed;  ///< the pins' values (0 elsewhere)
+  Eigen::SparseMatrix<Complex> lower;
+  Eigen::VectorXcd rhs;
+};
+
+PinnedConformalSystem pinned_conformal_system(const Region& region, const ConformalPins& pins) {
   const int nv = region.num_vertices();
   const auto nb = static_cast<int>(region.boundary.size());
-  std::vector<Eigen::Triplet<Complex>> h;
+  PinnedConformalSystem system;
+  system.index.assign(static_cast<size_t>(nv), -1);
+  system.fixed = Eigen::VectorXcd::Zero(nv);
+  system.fixed[pins.second] = pins.distance;
+  int free = 0;
+  for (int v = 0; v < nv; ++v) {
+    if (v != pins.first && v != pins.second) {
+      system.index[static_cast<size_t>(v)] = free++;
+    }
+  }
+  system.rhs = Eigen::VectorXcd::Zero(free);
+  std::vector<double> diagonal(static_cast<size_t>(nv), 0.0);
+  std::vector<Eigen::Triplet<Complex>> lower;
+  lower.reserve(3 * region.triangles.size() + static_cast<size_t>(nv + nb));
+  // H_ij += value and H_ji += conj(value), i != j.
+  const auto add_pair = [&](int i, int j, Complex value) {
+    const int fi = system.index[static_cast<size_t>(i)], fj = system.index[static_cast<size_t>(j)];
+    if (fi >= 0 && fj >= 0) {
+      if (fi > fj) {
+        lower.emplace_back(fi, fj, value);
+      } else {
+        lower.emplace_back(fj, fi, std::conj(value));
+      }
+    } else if (fi >= 0) {
+      system.rhs[fi] -= value * system.fixed[j];
+    } else if (fj >= 0) {
+      system.rhs[fj] -= std::conj(value) * system.fixed[i];
+    }
+  };
   for (const Eigen::Vector3i& t : region.triangles) {
     if (degenerate_in_3d(region, t)) {
       continue;  // no Dirichlet term and, below, no area term
@@ -311,15 +351,13 @@ Eigen::SparseMatrix<Complex> conformal_energy_form(const Region& region) {
       }
       // Edge (i, j) opposite corner l: 1/2 cot(l) |z_i - z_j|^2 enters E_D with 1/2.
       const double w = 0.25 * a.dot(b) / cross;
-      h.emplace_back(i, i, w);
-      h.emplace_back(j, j, w);
-      h.emplace_back(i, j, -w);
-      h.emplace_back(j, i, -w);
+      diagonal[static_cast<size_t>(i)] += w;
+      diagonal[static_cast<size_t>(j)] += w;
+      add_pair(i, j, -w);
     }
   }
   const auto add_area_edge = [&](int i, int j, double sign) {
-    h.emplace_back(i, j, Complex(0.0, 0.25 * sign));
-    h.emplace_back(j, i, Complex(0.0, -0.25 * sign));
+    add_pair(i, j, Complex(0.0, 0.25 * sign));
   };
   for (int k = 0; k < nb; ++k) {
     add_area_edge(region.boundary[static_cast<size_t>(k)],
@@ -338,56 +376,32 @@ Eigen::SparseMatrix<Complex> conformal_energy_form(const Region& region) {
       }
     }
   }
-  Eigen::SparseMatrix<Complex> full(nv, nv);
-  full.setFromTriplets(h.begin(), h.end());
-  return full;
+  for (int v = 0; v < nv; ++v) {
+    if (const int f = system.index[static_cast<size_t>(v)]; f >= 0) {
+      lower.emplace_back(f, f, diagonal[static_cast<size_t>(v)]);
+    }
+  }
+  system.lower.resize(free, free);
+  system.lower.setFromTriplets(lower.begin(), lower.end());
+  return system;
 }
 
-// Minimises z^H H z with the first pin at 0 and the second at `distance` (on the real axis): the
-// free unknowns solve H_ff z_f = -H_fp z_p, Hermitian positive definite once two vertices are
-// pinned.
-std::vector<Eigen::Vector2d> minimise_pinned(const Eigen::SparseMatrix<Complex>& full,
-                                             const ConformalPins& pins, const std::string& name) {
-  const auto nv = static_cast<int>(full.rows());
-  std::vector<int> index(static_cast<size_t>(nv), -1);
-  Eigen::VectorXcd fixed = Eigen::VectorXcd::Zero(nv);
-  fixed[pins.second] = pins.distance;
-  int free = 0;
-  for (int v = 0; v < nv; ++v) {
-    if (v != pins.first && v != pins.second) {
-      index[static_cast<size_t>(v)] = free++;
-    }
-  }
-  std::vector<Eigen::Triplet<Complex>> reduced;
-  reduced.reserve(static_cast<size_t>(full.nonZeros()));
-  Eigen::VectorXcd rhs = Eigen::VectorXcd::Zero(free);
-  for (int c = 0; c < full.outerSize(); ++c) {
-    for (Eigen::SparseMatrix<Complex>::InnerIterator it(full, c); it; ++it) {
-      const int r = index[static_cast<size_t>(it.row())], cc = index[static_cast<size_t>(it.col())];
-      if (r < 0) {
-        continue;
-      }
-      if (cc >= 0) {
-        reduced.emplace_back(r, cc, it.value());
-      } else {
-        rhs[r] -= it.value() * fixed[it.col()];
-      }
-    }
-  }
-  Eigen::SparseMatrix<Complex> a(free, free);
-  a.setFromTriplets(reduced.begin(), reduced.end());
-  Eigen::SimplicialLDLT<Eigen::SparseMatrix<Complex>> solver(a);
+// The conformal map's vertex coordinates (u, v): the pinned system solved.
+std::vector<Eigen::Vector2d> minimise_pinned(const PinnedConformalSystem& system,
+                                             const std::string& name) {
+  Eigen::SimplicialLDLT<Eigen::SparseMatrix<Complex>, Eigen::Lower> solver(system.lower);
   if (solver.info() != Eigen::Success) {
     throw NumericalError(name, "flattening: the LSCM system is singular");
   }
-  const Eigen::VectorXcd x = solver.solve(rhs);
+  const Eigen::VectorXcd x = solver.solve(system.rhs);
   if (solver.info() != Eigen::Success || !x.allFinite()) {
     throw NumericalError(name, "flattening: the LSCM solve failed");
   }
+  const auto nv = static_cast<int>(system.index.size());
   std::vector<Eigen::Vector2d> uv(static_cast<size_t>(nv));
   for (int v = 0; v < nv; ++v) {
-    const int r = index[static_cast<size_t>(v)];
-    const Complex z = r >= 0 ? x[r] : fixed[v];
+    const int r = system.index[static_cast<size_t>(v)];
+    const Complex z = r >= 0 ? x[r] : system.fixed[v];
     uv[static_cast<size_t>(v)] = Eigen::Vector2d(z.real(), z.imag());
   }
   return uv;
@@ -428,7 +442,7 @@ RegionFlattening flatten_conformal(const Region& region) {
           planar_coordinates(region, pins.first, pins.second)) {
     out.uv = std::move(*flat);
   } else {
-    out.uv = minimise_pinned(conformal_energy_form(region), pins, name);
+    out.uv = minimise_pinned(pinned_conformal_system(region, pins), name);
     scale_to_area(region, out.uv);
   }
   out.folded_triangles = count_folds(region, out.uv);
