@@ -705,12 +705,19 @@ void Sampler::write_back(AdaptiveSamplingResult& result) const {
 
 }  // namespace
 
-AdaptiveSamplingResult adaptive_sampling(const ParticleGrid& input, const Region& region,
+AdaptiveSamplingResult adaptive_sampling(const ParticleGrid& grid, const Region& region,
+                                         const SurfaceProjector& projector,
+                                         const AdaptiveSamplingOptions& options) {
+  validate(grid, options);
+  return adaptive_sampling(ParticleGrid(grid), region, projector, options);
+}
+
+AdaptiveSamplingResult adaptive_sampling(ParticleGrid&& input, const Region& region,
                                          const SurfaceProjector& projector,
                                          const AdaptiveSamplingOptions& options) {
   validate(input, options);
   AdaptiveSamplingResult result;
-  result.grid = input;
+  result.grid = std::move(input);
   Sampler sampler(result.grid, region, projector, options);
   if (!(sampler.mean_spring_length() > 0.0)) {
     throw InvalidInputError(options.name, "the particle grid has no springs");

@@ -136,9 +136,14 @@ struct AdaptiveSamplingResult {
 
 /// Runs eq. 8 on `grid` (laid out on `region`, whose surface is `projector.surface()`).
 /// \throws InvalidInputError naming options.name when the options are out of range or the grid does
-/// not
-///         match the region (no source points, a boundary particle without parameter).
+/// not match the region (no source points, a boundary particle without parameter).
 AdaptiveSamplingResult adaptive_sampling(const ParticleGrid& grid, const Region& region,
+                                         const SurfaceProjector& projector,
+                                         const AdaptiveSamplingOptions& options = {});
+/// The same on a grid the caller gives up: its springs and per-particle arrays are taken, not
+/// copied (the OpenMesh connectivity still is: its kernels declare destructors and so have no
+/// move). `elastic sample` of a million-particle flat disk: peak 1,735 -> 1,502 MB.
+AdaptiveSamplingResult adaptive_sampling(ParticleGrid&& grid, const Region& region,
                                          const SurfaceProjector& projector,
                                          const AdaptiveSamplingOptions& options = {});
 

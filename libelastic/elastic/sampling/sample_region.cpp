@@ -105,7 +105,7 @@ SampleRegionResult sample_region(const Region& region, const SurfaceProjector& p
   if (options.adaptive) {
     AdaptiveSamplingOptions sampling = options.sampling;
     sampling.name = options.layout.name;
-    result.sampling = adaptive_sampling(result.layout.grid, region, projector, sampling);
+    result.sampling = adaptive_sampling(std::move(result.layout.grid), region, projector, sampling);
     result.grid = std::move(result.sampling.grid);
     result.sampling.grid = ParticleGrid{};
     result.layout.grid = ParticleGrid{};
