@@ -74,14 +74,20 @@ void fold_the_start(NaiveProblem& naive) {
   const Eigen::Matrix3Xd source = grid.source_positions();
   int p = -1;
   for (int i = 0; i < grid.num_particles(); ++i) {
-    if (grid.is_boundary[static_cast<std::size_t>(i)]) continue;
-    if (p < 0 || source.col(i).norm() < source.col(p).norm()) p = i;
+    if (grid.is_boundary[static_cast<std::size_t>(i)]) {
+      continue;
+    }
+    if (p < 0 || source.col(i).norm() < source.col(p).norm()) {
+      p = i;
+    }
   }
   ASSERT_GE(p, 0);
   int q = -1;
   for (const Spring& s : grid.springs) {
     const int other = s.i == p ? s.j : (s.j == p ? s.i : -1);
-    if (other >= 0 && !grid.is_boundary[static_cast<std::size_t>(other)]) q = other;
+    if (other >= 0 && !grid.is_boundary[static_cast<std::size_t>(other)]) {
+      q = other;
+    }
   }
   ASSERT_GE(q, 0);
   RelaxationProblem& problem = naive.problem;
@@ -133,11 +139,14 @@ TEST(SquareToDisk, SettlesEveryParticleExceptAFewHeldAtTheCorners) {
   Eigen::Matrix3Xd gradient;
   SpringSystem(grid, {.rest_scale = problem.rest_scale}).evaluate(result.positions, &gradient);
   std::vector<char> held(static_cast<std::size_t>(grid.num_particles()), 0);
-  for (const int p : result.held_particles) held[static_cast<std::size_t>(p)] = 1;
+  for (const int p : result.held_particles) {
+    held[static_cast<std::size_t>(p)] = 1;
+  }
   double free_sum = 0.0;
   for (int p = 0; p < grid.num_particles(); ++p) {
-    if (grid.is_boundary[static_cast<std::size_t>(p)] || held[static_cast<std::size_t>(p)])
+    if (grid.is_boundary[static_cast<std::size_t>(p)] || held[static_cast<std::size_t>(p)]) {
       continue;
+    }
     const SurfaceDerivatives d = cap.derivatives(result.points[static_cast<std::size_t>(p)]);
     const Eigen::Vector3d n = d.du.cross(d.dv).normalized();
     const Eigen::Vector3d g = gradient.col(p);
@@ -192,7 +201,9 @@ double smallest_stretch(const ParticleGrid& grid, const Eigen::Matrix3Xd& target
   double smallest = std::numeric_limits<double>::infinity();
   for (const auto fh : grid.mesh.faces()) {
     std::vector<int> v;
-    for (const auto vh : grid.mesh.fv_range(fh)) v.push_back(vh.idx());
+    for (const auto vh : grid.mesh.fv_range(fh)) {
+      v.push_back(vh.idx());
+    }
     const int k = static_cast<int>(v.size());
     for (int c = 0; c < k; ++c) {
       const int i = v[c], a = v[(c + 1) % k], b = v[(c + k - 1) % k];

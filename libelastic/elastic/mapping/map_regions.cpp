@@ -348,14 +348,19 @@ MapResult map_cold(const SurfaceProjector& source, const Region& source_region,
   disk_work.wait();  // rethrows a disk map's error
   const double seconds_disks = seconds_since(start);
   const ParticleGrid& grid = result.sampling.grid;
+  result.source_disk = std::move(disks.source);
+  result.target_disk = std::move(disks.target);
 
   // 2a. The multilevel start's coarse map (MapOptions::coarse_start_above) on these disk maps: its
   // boundary offset is this map's too, and it returns the disk maps.
   std::optional<MapResult> coarse;
   if (uses_coarse_start(options, grid)) {
     start = std::chrono::steady_clock::now();
-    coarse.emplace(
-        coarse_map(source, source_region, target, target_region, options, std::move(disks)));
+    coarse.emplace(coarse_map(source, source_region, target, target_region, options,
+                              DiskMaps{.source = std::move(result.source_disk),
+                                       .target = std::move(result.target_disk)}));
+    result.source_disk = std::move(coarse->source_disk);
+    result.target_disk = std::move(coarse->target_disk);
     result.coarse_particles = coarse->sampling.grid.num_particles();
     result.coarse_iterations = coarse->relaxation.iterations + coarse->coarse_iterations;
     result.seconds_coarse = seconds_since(start);
@@ -364,13 +369,6 @@ MapResult map_cold(const SurfaceProjector& source, const Region& source_region,
   // 2. The naive map: both regions to the unit disk, composed (Fig. 9a).
   stage("naive map");
   start = std::chrono::steady_clock::now();
-  if (coarse) {
-    result.source_disk = std::move(coarse->source_disk);
-    result.target_disk = std::move(coarse->target_disk);
-  } else {
-    result.source_disk = std::move(disks.source);
-    result.target_disk = std::move(disks.target);
-  }
 
   // 3. Rest scale sigma between the two regions' sizes.
   result.rest_scale = region_rest_scale(options.rest_scale, source_region, target_region);
