@@ -156,20 +156,17 @@ TEST(RegionFlattening, LargeDiskMapSatisfiesTheMeanValueEquations) {
   EXPECT_LT(worst, 1e-9);
 }
 
-/// The largest distance of a planar region's flattening from the best similarity uv ~ a z + b (z =
-/// x + iy; the region lies in z = 0), fitted by least squares over complex numbers; `scale` = |a|.
-double similarity_residual(const Region& region, const RegionFlattening& flat, double& scale) {
+/// The largest distance of `to` from the best similarity of `from`, to ~ a from + b (points as
+/// complex numbers), fitted by least squares; `scale` = |a|. A reflection (to ~ a conj(from) + b)
+/// is not a similarity here and leaves a residual of the points' size.
+double similarity_residual(const std::vector<Eigen::Vector2d>& from,
+                           const std::vector<Eigen::Vector2d>& to, double& scale) {
   using C = std::complex<double>;
-  const auto n = static_cast<double>(region.num_vertices());
-  const auto z_of = [&](int v) {
-    return C(region.positions[static_cast<size_t>(v)].x(),
-             region.positions[static_cast<size_t>(v)].y());
-  };
-  const auto w_of = [&](int v) {
-    return C(flat.uv[static_cast<size_t>(v)].x(), flat.uv[static_cast<size_t>(v)].y());
-  };
+  const auto n = static_cast<double>(from.size());
+  const auto z_of = [&](size_t v) { return C(from[v].x(), from[v].y()); };
+  const auto w_of = [&](size_t v) { return C(to[v].x(), to[v].y()); };
   C mz = 0.0, mw = 0.0;
-  for (int v = 0; v < region.num_vertices(); ++v) {
+  for (size_t v = 0; v < from.size(); ++v) {
     mz += z_of(v);
     mw += w_of(v);
   }
@@ -177,17 +174,27 @@ double similarity_residual(const Region& region, const RegionFlattening& flat, d
   mw /= n;
   C num = 0.0;
   double den = 0.0;
-  for (int v = 0; v < region.num_vertices(); ++v) {
+  for (size_t v = 0; v < from.size(); ++v) {
     num += std::conj(z_of(v) - mz) * (w_of(v) - mw);
     den += std::norm(z_of(v) - mz);
   }
   const C a = num / den;
   double worst = 0.0;
-  for (int v = 0; v < region.num_vertices(); ++v) {
+  for (size_t v = 0; v < from.size(); ++v) {
     worst = std::max(worst, std::abs((w_of(v) - mw) - a * (z_of(v) - mz)));
   }
   scale = std::abs(a);
   return worst;
+}
+
+/// The same for a planar region's flattening against its points' (x, y) (the region lies in z = 0).
+double similarity_residual(const Region& region, const RegionFlattening& flat, double& scale) {
+  std::vector<Eigen::Vector2d> xy;
+  xy.reserve(region.positions.size());
+  for (const Eigen::Vector3d& p : region.positions) {
+    xy.emplace_back(p.x(), p.y());
+  }
+  return similarity_residual(xy, flat.uv, scale);
 }
 
 // A planar region's conformal flattening: fold-free and a similarity (its identity has zero
@@ -229,6 +236,55 @@ TEST(RegionFlattening, ConformalMapOfAFlatRegionIsItsIsometryExactly) {
     }
   }
   EXPECT_LT(worst, 1e-12 * 1.2);
+}
+
+// A developable region off every plane, where the conformal solve runs (the planar shortcut refuses
+// it): a rectangle bent around the unit cylinder, the vertices of a grid at angles i * step and
+// heights j * height, each quad split in two. Every quad is planar (a chord x height rectangle), so
+// the triangles unroll isometrically onto the plane, where the columns lie one chord apart: that
+// unrolling has zero conformal energy, and the minimiser must be it up to a similarity, scaled to
+// the 3D area (|a| = 1) and not mirrored. Written independently of the solver: a sign error in the
+// area term makes the minimiser a reflection, which folds every triangle and falls back to the
+// disk map.
+TEST(RegionFlattening, ConformalMapOfABentRectangleIsItsUnrolling) {
+  constexpr int kColumns = 12, kRows = 7;
+  constexpr double kStep = 0.15, kHeight = 0.09;
+  const double chord = 2.0 * std::sin(kStep / 2.0);
+  Region region;
+  std::vector<Eigen::Vector2d> unrolled;
+  for (int j = 0; j <= kRows; ++j) {
+    for (int i = 0; i <= kColumns; ++i) {
+      region.positions.emplace_back(std::cos(i * kStep), std::sin(i * kStep), j * kHeight);
+      unrolled.emplace_back(i * chord, j * kHeight);
+    }
+  }
+  region.points.resize(region.positions.size());
+  const auto id = [](int i, int j) { return j * (kColumns + 1) + i; };
+  for (int j = 0; j < kRows; ++j) {
+    for (int i = 0; i < kColumns; ++i) {
+      region.triangles.emplace_back(id(i, j), id(i + 1, j), id(i + 1, j + 1));
+      region.triangles.emplace_back(id(i, j), id(i + 1, j + 1), id(i, j + 1));
+    }
+  }
+  // Counter-clockwise in the unrolled plane, as the triangles are.
+  for (int i = 0; i < kColumns; ++i) {
+    region.boundary.push_back(id(i, 0));
+  }
+  for (int j = 0; j < kRows; ++j) {
+    region.boundary.push_back(id(kColumns, j));
+  }
+  for (int i = kColumns; i > 0; --i) {
+    region.boundary.push_back(id(i, kRows));
+  }
+  for (int j = kRows; j > 0; --j) {
+    region.boundary.push_back(id(0, j));
+  }
+  const RegionFlattening flat = flatten_region(region, {.method = FlatteningMethod::Conformal});
+  EXPECT_EQ(flat.method, FlatteningMethod::Conformal);
+  EXPECT_EQ(flat.folded_triangles, 0);
+  double scale = 0.0;
+  EXPECT_LT(similarity_residual(unrolled, flat.uv, scale), 1e-9);
+  EXPECT_NEAR(scale, 1.0, 1e-9);
 }
 
 // A star whose sides run through two welded copies of a tessellation vertex (a zero-area triangle
