@@ -108,6 +108,7 @@ TEST(Cli, BadRegionsAndValuesNameTheFlag) {
   expect_error(elastic(base + "--source-anchor nan,0,0", dir), 64, "--source-anchor");
   expect_error(elastic(base + "--particles 1000000000", dir), 64, "--particles");
   expect_error(elastic(base + "--particles 3", dir), 64, "--particles");
+  expect_error(elastic(base + "--coarse-hold -1", dir), 64, "--coarse-hold");
   // Usage errors: an unknown flag, a missing required flag, a bad choice.
   EXPECT_EQ(elastic(base + "--no-such-flag", dir).code, 64);
   expect_error(elastic("map --source " + mesh("plane_quads.obj"), dir), 64, "--target");
@@ -124,8 +125,10 @@ TEST(Cli, ReportIsWrittenWholeOrNotAtAll) {
   expect_error(run, 73, "r.json");
   EXPECT_FALSE(fs::exists(dir / "no"));
   // A good report survives a later failing run that names it.
-  ASSERT_EQ(elastic(base + "--report " + (dir / "r.json").string(), dir).code, 0);
+  ASSERT_EQ(elastic(base + "--coarse-hold 123 --report " + (dir / "r.json").string(), dir).code, 0);
   const auto size = fs::file_size(dir / "r.json");
+  EXPECT_EQ(nlohmann::json::parse(std::ifstream(dir / "r.json"))["coarse_start"]["hold_above"],
+            123);
   const std::string failing = "map -q --source " + mesh("plane_quads.obj") +
                               " --source-region disk:0,0,50,1 --target " + mesh("cap_quads.obj") +
                               " --report " + (dir / "r.json").string();

@@ -168,6 +168,12 @@ void add_map_flags(CLI::App& sub, MapJob& a) {
                  "(the coarse map chooses the boundary offset and where a sliding boundary goes); "
                  "0: never")
       ->check(CLI::Range(0L, static_cast<long>(kMaxParticles)));
+  sub.add_option("--coarse-hold", a.coarse_hold,
+                 "N: with --coarse-start, a sliding boundary on a grid of more than N particles "
+                 "(default 500000) is held where the coarse map slid it, if that slide reached its "
+                 "tolerance (faster; the coarse boundary can cost energy on compressed regions); "
+                 "on smaller grids it slides on")
+      ->check(CLI::Range(0L, static_cast<long>(kMaxParticles)));
   sub.add_option("--rest-scale", a.rest_scale,
                  "auto (default: the smaller of boundary and area) | boundary | area | none")
       ->check(CLI::IsMember({"auto", "boundary", "area", "none"}));
@@ -252,6 +258,7 @@ MapOptions make_map_options(const MapJob& job, const ProgressCallback& progress)
   options.distortion_guard = job.distortion_guard == "on";
   options.subdivisions = job.subdivide;
   options.coarse_start_above = static_cast<int>(job.coarse_start);
+  options.coarse_hold_above = static_cast<int>(job.coarse_hold);
   options.progress = progress;
   options.relaxation.progress = progress;
   return options;
@@ -548,6 +555,7 @@ nlohmann::json map_report(const MapJob& job, const MapSession& session,
         {"iterations", r.guard.iterations}}},
       {"coarse_start",
        {{"above", job.coarse_start},
+        {"hold_above", job.coarse_hold},
         {"particles", r.coarse_particles},
         {"iterations", r.coarse_iterations}}},
       {"boundary_residual", x.boundary_residual},

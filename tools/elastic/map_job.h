@@ -53,6 +53,9 @@ struct MapJob {
   int subdivide = 0;                         ///< --subdivide K: refinement levels after the map
   /// --coarse-start N: grids of more than N particles start from a coarser grid's map (0: never)
   long coarse_start = MapOptions{}.coarse_start_above;
+  /// --coarse-hold N: such a grid above N particles holds its sliding boundary where the coarse
+  /// map slid it
+  long coarse_hold = MapOptions{}.coarse_hold_above;
   int threads = 0;      ///< --threads N (0: all)
   double jitter = 0.0;  ///< --jitter F: random start of the sampling
   /// --curvature-radius S: the sampling's curvature averaged over S grid spacings (0: pointwise)

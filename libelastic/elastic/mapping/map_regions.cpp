@@ -143,16 +143,27 @@ MapResult coarse_map(const SurfaceProjector& source, const Region& source_region
                   std::move(disks));
 }
 
+// Whether a slide phase stopped at its gradient tolerance (the boundary at an equilibrium of the
+// coarse grid) rather than at its settle test or its iteration limit (still drifting along the
+// curve).
+bool slide_reached_equilibrium(StopReason reason) {
+  return reason == StopReason::RelativeGradient || reason == StopReason::AbsoluteGradient ||
+         reason == StopReason::RoundOff;
+}
+
 // Starts `problem` (the naive map's) from the coarse map carried onto `grid` (prolonged_map) and
 // returns the options to relax it with. The stopping tests refer to the coarse start's gradient, as
 // a warm start's do to its previous map's (|P g| of the naive map hardly depends on the particle
 // count: 0.26, 0.24 and 0.20 at 5,777, 24,984 and 100,536 particles on Plane -> Cap). A fixed
-// boundary keeps the naive map's arc-length positions exactly. On the grid the caller asked for
-// (`hold`), a sliding boundary is held where the coarse map slid it (its parameters interpolated):
-// on Plane -> Cap, sliding again on that grid lowered the energy by 0.003% at 1,001,732 particles
-// (0.013% at 100,536), for 44 iterations that took two thirds of the solve. The levels below it
-// slide from the carried start, so that the boundary is the next level's and not the coarsest's
-// (held from 15,625 particles at every level, the energy at 1M was 0.016% above the cold map's).
+// boundary keeps the naive map's arc-length positions exactly. With `hold` (the grid the caller
+// asked for, above MapOptions::coarse_hold_above), a sliding boundary is held where the coarse map
+// slid it (its parameters interpolated), if that slide reached its gradient tolerance: on Plane ->
+// Cap, sliding again on that grid lowered the energy by 0.003% at 1,001,732 particles, for a solve
+// of 13.8 instead of 5.8 s. A slide stopped by its settle test or its limit was still moving the
+// boundary (the rectangle image onto spot's flank, where a 25,000-particle grid held there
+// stagnated 0.14% above the cold map's energy). Every other level slides from the carried start,
+// so that the boundary is its own grid's: held from 1/8 as many particles, the compressed
+// hemisphere -> spot side map ended 1.2% above (100,536 particles) and 10% above (24,984).
 // Left on the naive start (and the options as given) when a particle could not be carried.
 RelaxationOptions start_from_coarse(const ParticleGrid& grid, const MapResult& coarse,
                                     const RelaxationOptions& options, bool hold,
@@ -169,7 +180,9 @@ RelaxationOptions start_from_coarse(const ParticleGrid& grid, const MapResult& c
   }
   RelaxationOptions held = options;
   if (slide) {
-    held.boundary = hold ? BoundaryMode::Fixed : BoundaryMode::Slide;
+    held.boundary = hold && slide_reached_equilibrium(coarse.relaxation.slide_reason)
+                        ? BoundaryMode::Fixed
+                        : BoundaryMode::Slide;
     problem.boundary_parameters = std::move(boundary);  // the start (held: where it went)
   }
   for (std::size_t k = 0; k < grid.boundary_loop.size(); ++k) {
@@ -207,14 +220,19 @@ void report_coarse_slide(const ParticleGrid& grid, const RelaxationResult& coars
 // the coarse map is carried over, its queryable mapping and naive map go: with the copy of the
 // naive problem this kept before, 80 MB that lived through a million-particle relaxation.
 void relax_from_coarse(const ParticleGrid& grid, MapResult& coarse, const MapOptions& options,
-                       bool top, MapResult& result, RelaxationProblem& problem) {
+                       bool hold, MapResult& result, RelaxationProblem& problem) {
   const RelaxationOptions held =
-      start_from_coarse(grid, coarse, options.relaxation, top, result, problem);
+      start_from_coarse(grid, coarse, options.relaxation, hold, result, problem);
   coarse.mapping = Mapping();
   coarse.naive = InitialMap();
   result.relaxation = relax(problem, held);
   if (held.boundary != options.relaxation.boundary) {
     report_coarse_slide(grid, coarse.relaxation, result.relaxation);
+  } else if (held.boundary == BoundaryMode::Slide) {
+    // Slid on this grid from where the coarse map had slid it: measured from the arc-length
+    // correspondence, as a cold map's slide is.
+    result.relaxation.boundary_slide = solver_detail::boundary_slide(
+        grid.boundary_parameter, result.relaxation.boundary_parameters);
   }
   if (result.relaxation.reason == StopReason::Cancelled ||
       (result.relaxation.converged && result.relaxation.folded_faces == 0)) {
@@ -242,9 +260,10 @@ void check_options(const MapOptions& options) {
   if (options.subdivisions < 0) {
     throw InvalidInputError("subdivisions", "must be 0 or more");
   }
-  if (options.coarse_start_above < 0 || options.coarse_start_ratio < 2) {
+  if (options.coarse_start_above < 0 || options.coarse_hold_above < 0 ||
+      options.coarse_start_ratio < 2) {
     throw InvalidInputError("coarse start",
-                            "needs a particle count of 0 or more and a ratio of at least 2");
+                            "needs particle counts of 0 or more and a ratio of at least 2");
   }
   if (options.subdivisions > 0 && options.relaxation.boundary == BoundaryMode::Slide) {
     // refine_map places new boundary particles at the source parameters' midpoints.
@@ -387,7 +406,8 @@ MapResult map_cold(const SurfaceProjector& source, const Region& source_region,
   RelaxationProblem problem =
       relaxation_problem(grid, target, result.naive, result, options.rest_scale);
   if (coarse) {
-    relax_from_coarse(grid, *coarse, options, top, result, problem);
+    const bool hold = top && grid.num_particles() > options.coarse_hold_above;
+    relax_from_coarse(grid, *coarse, options, hold, result, problem);
     coarse.reset();  // its grid and mapping are not needed any more (its disk maps are ours)
   } else {
     result.relaxation = relax(problem, options.relaxation);

@@ -59,12 +59,20 @@ struct MapOptions {
   /// of the same source region (mapped by these options, so a million particles go through 125,000
   /// and 15,625), carried onto it by prolonged_map (mapping/initial_map.h), instead of from the
   /// naive map. The coarsest map decides the boundary offset. A sliding boundary slides on each
-  /// coarse level from the one below; this grid holds it where the level below slid it and only
-  /// its interior relaxes (RelaxationResult::slide_iterations is then 0). On the Plane -> Cap
-  /// benchmark at 1,001,732 particles the naive start's slide crept for 222 iterations at 0.7 s
-  /// each, its first ring crowded against the hemisphere's rim: 186 s for the whole map, 21 s with
-  /// this start, the energy 0.003% above (docs/results.md, Speed). 0: never.
+  /// coarse level from the one below, and on this grid too unless `coarse_hold_above` holds it. On
+  /// the Plane -> Cap benchmark at 1,001,732 particles the naive start's slide crept for 222
+  /// iterations at 0.7 s each, its first ring crowded against the hemisphere's rim: 186 s for the
+  /// whole map, 21 s with this start, the energy 0.003% above (docs/results.md, Speed). 0: never.
   int coarse_start_above = 50000;
+  /// A multilevel start's sliding boundary on the grid asked for: held where the level below slid
+  /// it (only the interior relaxes) when the grid has more than `coarse_hold_above` particles and
+  /// that slide stopped at its gradient tolerance; otherwise it slides on from there. Holding
+  /// skips the finest slide, but leaves the boundary where a grid of 1/8 as many particles put it:
+  /// on the compressed hemisphere -> spot side map at 100,536 particles that cost 1.2% of energy
+  /// and sigma_min 0.547 against 0.748 (sliding on: 8.5 instead of 5.4 s); on Plane -> Cap at
+  /// 1,001,732 particles 0.003% of energy for 27 instead of 15 s (docs/results.md, Speed).
+  /// 0: held at every size whose coarse slide reached its tolerance.
+  int coarse_hold_above = 500000;
   /// Particles of the fine grid per particle of the coarse one (at least 2).
   int coarse_start_ratio = 8;
   /// Called between stages ("sample", "naive map", "relax", "subdivide", "relax refined",
