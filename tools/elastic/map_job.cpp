@@ -170,9 +170,8 @@ void add_map_flags(CLI::App& sub, MapJob& a) {
       ->check(CLI::Range(0L, static_cast<long>(kMaxParticles)));
   sub.add_option("--coarse-hold", a.coarse_hold,
                  "N: with --coarse-start, a sliding boundary on a grid of more than N particles "
-                 "(default 500000) is held where the coarse map slid it, if that slide reached its "
-                 "tolerance (faster; the coarse boundary can cost energy on compressed regions); "
-                 "on smaller grids it slides on")
+                 "(default 500000) is held where the coarse map slid it (faster; the coarse "
+                 "boundary can cost energy on compressed regions); on smaller grids it slides on")
       ->check(CLI::Range(0L, static_cast<long>(kMaxParticles)));
   sub.add_option("--rest-scale", a.rest_scale,
                  "auto (default: the smaller of boundary and area) | boundary | area | none")

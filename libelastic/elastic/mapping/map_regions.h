@@ -65,13 +65,13 @@ struct MapOptions {
   /// whole map, 21 s with this start, the energy 0.003% above (docs/results.md, Speed). 0: never.
   int coarse_start_above = 50000;
   /// A multilevel start's sliding boundary on the grid asked for: held where the level below slid
-  /// it (only the interior relaxes) when the grid has more than `coarse_hold_above` particles and
-  /// that slide stopped at its gradient tolerance; otherwise it slides on from there. Holding
-  /// skips the finest slide, but leaves the boundary where a grid of 1/8 as many particles put it:
-  /// on the compressed hemisphere -> spot side map at 100,536 particles that cost 1.2% of energy
-  /// and sigma_min 0.547 against 0.748 (sliding on: 8.5 instead of 5.4 s); on Plane -> Cap at
-  /// 1,001,732 particles 0.003% of energy for 27 instead of 15 s (docs/results.md, Speed).
-  /// 0: held at every size whose coarse slide reached its tolerance.
+  /// it (only the interior relaxes) when the grid has more than `coarse_hold_above` particles;
+  /// otherwise it slides on from there. Holding skips the finest slide, but leaves the boundary
+  /// where a grid of 1/8 as many particles put it: on the compressed hemisphere -> spot side map
+  /// that cost 1.2% of energy and sigma_min 0.547 against 0.748 at 100,536 particles (5.4 against
+  /// 8.5 s), 0.47% and 0.602 against 0.685 at 1,001,732 (47 against 189 s); on Plane -> Cap at
+  /// 1,001,732 particles 0.003% of energy (15 against 27 s; docs/results.md, Speed). 0: held at
+  /// every size.
   int coarse_hold_above = 500000;
   /// Particles of the fine grid per particle of the coarse one (at least 2).
   int coarse_start_ratio = 8;
