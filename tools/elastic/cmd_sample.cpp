@@ -31,7 +31,7 @@ struct SampleArgs {
   double curvature_radius = AdaptiveSamplingOptions{}.curvature_radius;
   bool adaptive = true;
   bool fixed_boundary = false;
-  std::string flattening = "conformal";
+  std::string flattening = "boundary-first";
   std::string out;
   std::string report;
   bool quiet = false;
@@ -56,8 +56,10 @@ int run_sample(const SampleArgs& args, const CLI::App& sub) {
   SampleRegionOptions options;
   options.layout.particles = args.particles;
   options.layout.name = "--source-region";
-  options.layout.flattening =
-      args.flattening == "disk" ? FlatteningMethod::Disk : FlatteningMethod::Conformal;
+  options.layout.flattening = args.flattening == "disk" ? FlatteningMethod::Disk
+                              : args.flattening == "boundary-first"
+                                  ? FlatteningMethod::BoundaryFirst
+                                  : FlatteningMethod::Conformal;
   options.adaptive = args.adaptive;
   options.sampling.seed = args.seed;
   options.sampling.jitter = args.jitter;
@@ -90,7 +92,10 @@ int run_sample(const SampleArgs& args, const CLI::App& sub) {
       {"triangles", st.triangles},
       {"count_error", sampled.layout.count_error},
       {"lattice_spacing", sampled.layout.spacing},
-      {"flattening", sampled.layout.flattening == FlatteningMethod::Disk ? "disk" : "conformal"},
+      {"flattening", sampled.layout.flattening == FlatteningMethod::Disk ? "disk"
+                     : sampled.layout.flattening == FlatteningMethod::BoundaryFirst
+                         ? "boundary-first"
+                         : "conformal"},
       {"region_area", region.area()},
       {"sampling",
        {{"spacing_min", st.spacing_min},
@@ -165,8 +170,10 @@ ELASTIC_COMMAND("sample", "Sample a source region with the particle grid", [](CL
                "Keep the regular layout (no curvature adaptation)");
   sub.add_flag("--fixed-boundary", args->fixed_boundary,
                "Keep boundary particles at equal arc length");
-  sub.add_option("--flattening", args->flattening, "Flattening used for the layout")
-      ->check(CLI::IsMember({"conformal", "disk"}));
+  sub.add_option("--flattening", args->flattening,
+                 "Flattening used for the layout: boundary first (conformal, keeps the boundary's "
+                 "lengths), least-squares conformal, or the mean-value disk map")
+      ->check(CLI::IsMember({"boundary-first", "conformal", "disk"}));
   sub.add_option("--scheme", args->scheme, "Subdivision scheme")
       ->check(CLI::IsMember({"auto", "loop", "catmull-clark"}));
   sub.add_option("--out", args->out, "Write the grid (particles and springs' faces): .obj or .ply");

@@ -16,6 +16,7 @@
 #include "elastic/numerics/bicgstab.h"
 #include "elastic/numerics/graph_laplacian.h"
 #include "elastic/numerics/multigrid.h"
+#include "elastic/regions/boundary_first_flattening.h"
 
 namespace elastic {
 namespace {
@@ -449,13 +450,40 @@ RegionFlattening flatten_conformal(const Region& region) {
   return out;
 }
 
+/// Boundary first flattening (boundary_first_flattening.h) scaled to the region's 3D area; a planar
+/// region is laid out in its own plane as by flatten_conformal, and a region the method does not
+/// apply to is reported as folded everywhere (the caller falls back).
+RegionFlattening flatten_boundary_first(const Region& region) {
+  const ConformalPins pins = conformal_pins(region);
+  RegionFlattening out;
+  out.method = FlatteningMethod::BoundaryFirst;
+  if (std::optional<std::vector<Eigen::Vector2d>> flat =
+          planar_coordinates(region, pins.first, pins.second)) {
+    out.uv = std::move(*flat);
+  } else if (std::optional<std::vector<Eigen::Vector2d>> bff =
+                 boundary_first_flattening(region, pins.first, pins.second)) {
+    out.uv = std::move(*bff);
+    scale_to_area(region, out.uv);
+  } else {
+    out.folded_triangles = region.num_triangles();
+    return out;
+  }
+  out.folded_triangles = count_folds(region, out.uv);
+  return out;
+}
+
 }  // namespace
 
 RegionFlattening flatten_region(const Region& region, const FlatteningOptions& options) {
   if (region.triangles.empty() || region.boundary.size() < 3) {
     throw InvalidInputError(region_name(region), "flattening: the region is empty");
   }
-  if (options.method == FlatteningMethod::Conformal) {
+  if (options.method == FlatteningMethod::BoundaryFirst) {
+    if (RegionFlattening flat = flatten_boundary_first(region); flat.folded_triangles == 0) {
+      return flat;
+    }
+  }
+  if (options.method != FlatteningMethod::Disk) {
     RegionFlattening conformal = flatten_conformal(region);
     if (conformal.folded_triangles == 0) {
       return conformal;

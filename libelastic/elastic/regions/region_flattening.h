@@ -10,6 +10,9 @@
 ///   it never folds.
 /// - Conformal: least-squares conformal map with a free boundary, scaled to the region's 3D area;
 ///   falls back to Disk if it folds (result says so).
+/// - BoundaryFirst: boundary first flattening (boundary_first_flattening.h), a conformal map that
+///   keeps the boundary's lengths, scaled to the region's 3D area; falls back to Conformal when it
+///   does not apply or folds (and from there to Disk).
 
 #include <Eigen/Core>
 #include <vector>
@@ -18,7 +21,7 @@
 
 namespace elastic {
 
-enum class FlatteningMethod { Disk, Conformal };
+enum class FlatteningMethod { Disk, Conformal, BoundaryFirst };
 
 struct FlatteningOptions {
   FlatteningMethod method = FlatteningMethod::Disk;  ///< which map
