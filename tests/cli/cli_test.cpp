@@ -136,15 +136,15 @@ TEST(Cli, ReportIsWrittenWholeOrNotAtAll) {
   EXPECT_EQ(fs::file_size(dir / "r.json"), size);
 }
 
-// `elastic sample` lays a curved region out by boundary first flattening unless asked otherwise,
-// and its report says which flattening was used.
+// `elastic sample` lays a curved region out by the least-squares conformal map unless asked
+// otherwise, and its report says which flattening was used.
 TEST(Cli, SampleReportsItsFlattening) {
   const fs::path dir = test::scratch_dir("cli_flattening");
   const std::string base = "sample -q --source " + mesh("cap_quads.obj") +
                            " --source-region disk:0,0,1,0.6 --particles 300 --report " +
                            (dir / "s.json").string();
-  for (const auto& [flag, expected] : {std::pair<std::string, std::string>{"", "boundary-first"},
-                                       {" --flattening conformal", "conformal"},
+  for (const auto& [flag, expected] : {std::pair<std::string, std::string>{"", "conformal"},
+                                       {" --flattening boundary-first", "boundary-first"},
                                        {" --flattening disk", "disk"}}) {
     ASSERT_EQ(elastic(base + flag, dir).code, 0) << flag;
     EXPECT_EQ(nlohmann::json::parse(std::ifstream(dir / "s.json"))["flattening"], expected) << flag;

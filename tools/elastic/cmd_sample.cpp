@@ -31,7 +31,7 @@ struct SampleArgs {
   double curvature_radius = AdaptiveSamplingOptions{}.curvature_radius;
   bool adaptive = true;
   bool fixed_boundary = false;
-  std::string flattening = "boundary-first";
+  std::string flattening = "conformal";
   std::string out;
   std::string report;
   bool quiet = false;
@@ -171,9 +171,10 @@ ELASTIC_COMMAND("sample", "Sample a source region with the particle grid", [](CL
   sub.add_flag("--fixed-boundary", args->fixed_boundary,
                "Keep boundary particles at equal arc length");
   sub.add_option("--flattening", args->flattening,
-                 "Flattening used for the layout: boundary first (conformal, keeps the boundary's "
-                 "lengths), least-squares conformal, or the mean-value disk map")
-      ->check(CLI::IsMember({"boundary-first", "conformal", "disk"}));
+                 "Flattening used for the layout: least-squares conformal, boundary first "
+                 "(conformal, keeps the boundary's lengths; faster, spreads the spacings more on "
+                 "large curved regions), or the mean-value disk map")
+      ->check(CLI::IsMember({"conformal", "boundary-first", "disk"}));
   sub.add_option("--scheme", args->scheme, "Subdivision scheme")
       ->check(CLI::IsMember({"auto", "loop", "catmull-clark"}));
   sub.add_option("--out", args->out, "Write the grid (particles and springs' faces): .obj or .ply");

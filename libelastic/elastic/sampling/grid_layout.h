@@ -53,15 +53,14 @@ struct GridLayoutOptions {
   /// Minimum distance of a kept lattice point from the boundary polygon, in units of h. Must exceed
   /// 1/sqrt(2) (see the file comment); larger values make the boundary band wider.
   double clearance = 0.75;
-  /// Flattening used for the layout; BoundaryFirst falls back to Conformal where it does not apply
-  /// or folds, and Conformal to Disk. BoundaryFirst factorises a real system of half the size of
-  /// the least-squares conformal map's complex one (whole hemisphere.off at 5,775 particles:
-  /// `elastic sample` 0.44 -> 0.32 s; a nefertiti face disk at 2,000: 3.4 -> 1.9 s) and lays out
-  /// the conformal map that keeps the boundary's lengths, where the least-squares map's two pins
-  /// leave a Moebius-like freedom to the discretisation. Over the robustness benchmark's curved
-  /// sources at five particle counts each, the maps' length energy moved by a median -0.07% and
-  /// their sigma_min by +0.7% (docs/results/speed.md).
-  FlatteningMethod flattening = FlatteningMethod::BoundaryFirst;
+  /// Flattening used for the layout; Conformal falls back to Disk when it folds, BoundaryFirst to
+  /// Conformal where it does not apply or folds. BoundaryFirst factorises a real system of half
+  /// the size (whole hemisphere.off at 5,775 particles: the map 0.74 -> 0.58 s) but keeps the
+  /// boundary's lengths, which leaves all the scale change inside: on large curved regions of a
+  /// scan the grid's spacings spread far more (a nefertiti-lowres.obj disk of radius 98.7: 0.70 to
+  /// 9.0 around 2.6, against 1.4 to 5.5), and maps from there came out worse (length energy up to
+  /// 3x), so Conformal stays the default (docs/results/speed.md).
+  FlatteningMethod flattening = FlatteningMethod::Conformal;
   /// Spacing search steps (each counts the lattice once).
   int max_search_steps = 40;
   /// Name of the region in error messages (e.g. "--region").
