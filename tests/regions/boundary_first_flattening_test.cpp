@@ -14,6 +14,7 @@
 #include "elastic/regions/region_flattening.h"
 #include "elastic/regions/region_spec.h"
 #include "elastic/shapes/procedural_shapes.h"
+#include "region_cases.h"
 
 namespace elastic {
 namespace {
@@ -32,44 +33,16 @@ int folds(const Region& region, const std::vector<Eigen::Vector2d>& uv) {
   return n;
 }
 
-// A rectangle bent around the unit cylinder (12 x 7 planar quads, each split in two): every
+// A rectangle bent around the unit cylinder (region_cases.h, 12 x 7 planar quads): every
 // interior angle sum is 2 pi and every boundary turn is the unrolled rectangle's, so the scale
 // factor is 0 and the flattening is the unrolling itself, with vertex `first` at the origin and
 // `second` on the positive x axis: a rigid motion of (i * chord, j * height), not a similarity.
 TEST(BoundaryFirstFlattening, UnrollsABentRectangleExactly) {
-  constexpr int kColumns = 12, kRows = 7;
-  constexpr double kStep = 0.15, kHeight = 0.09;
-  const double chord = 2.0 * std::sin(kStep / 2.0);
-  Region region;
-  std::vector<Eigen::Vector2d> unrolled;
-  for (int j = 0; j <= kRows; ++j) {
-    for (int i = 0; i <= kColumns; ++i) {
-      region.positions.emplace_back(std::cos(i * kStep), std::sin(i * kStep), j * kHeight);
-      unrolled.emplace_back(i * chord, j * kHeight);
-    }
-  }
-  region.points.resize(region.positions.size());
-  const auto id = [](int i, int j) { return j * (kColumns + 1) + i; };
-  for (int j = 0; j < kRows; ++j) {
-    for (int i = 0; i < kColumns; ++i) {
-      region.triangles.emplace_back(id(i, j), id(i + 1, j), id(i + 1, j + 1));
-      region.triangles.emplace_back(id(i, j), id(i + 1, j + 1), id(i, j + 1));
-    }
-  }
-  for (int i = 0; i < kColumns; ++i) {
-    region.boundary.push_back(id(i, 0));
-  }
-  for (int j = 0; j < kRows; ++j) {
-    region.boundary.push_back(id(kColumns, j));
-  }
-  for (int i = kColumns; i > 0; --i) {
-    region.boundary.push_back(id(i, kRows));
-  }
-  for (int j = kRows; j > 0; --j) {
-    region.boundary.push_back(id(0, j));
-  }
-  // Pins: the corner (0, 0) and the corner (kColumns, 0), so the unrolling needs no rotation.
-  const auto uv = boundary_first_flattening(region, id(0, 0), id(kColumns, 0));
+  const test::BentRectangle strip = test::bent_rectangle();
+  const Region& region = strip.region;
+  const std::vector<Eigen::Vector2d>& unrolled = strip.unrolled;
+  // Pins: the corner (0, 0) and the corner (columns, 0), so the unrolling needs no rotation.
+  const auto uv = boundary_first_flattening(region, strip.origin, strip.along);
   ASSERT_TRUE(uv.has_value());
   double worst = 0.0;
   for (size_t v = 0; v < unrolled.size(); ++v) {
@@ -196,14 +169,7 @@ TEST(BoundaryFirstFlattening, FlattenRegionUsesItOrFallsBack) {
   const auto plane = make_plane({.faces = ShapeFaces::Quads, .resolution = 32});
   const LimitSurface flat_surface(plane);
   const SurfaceProjector flat_projector(flat_surface);
-  RegionSpec star;
-  star.kind = RegionSpec::Kind::Points;
-  for (int k = 0; k < 10; ++k) {
-    const double angle = kPi / 2 + kPi * k / 5;
-    const double r = (k % 2 == 0) ? 0.8 : 0.38 * 0.8;
-    star.points.emplace_back(r * std::cos(angle), -0.05 + r * std::sin(angle), 0.0);
-  }
-  Region welded = make_region(flat_projector, star);
+  Region welded = make_region(flat_projector, test::welded_star());
   // Lift it off its plane so the planar shortcut does not answer first.
   for (Eigen::Vector3d& p : welded.positions) {
     p.z() = 0.3 * p.x() * p.x();

@@ -13,6 +13,7 @@
 #include "elastic/regions/region_flattening.h"
 #include "elastic/regions/region_spec.h"
 #include "elastic/shapes/procedural_shapes.h"
+#include "region_cases.h"
 #include "rigid_motion.h"
 
 namespace elastic {
@@ -239,46 +240,15 @@ TEST(RegionFlattening, ConformalMapOfAFlatRegionIsItsIsometryExactly) {
 }
 
 // A developable region off every plane, where the conformal solve runs (the planar shortcut refuses
-// it): a rectangle bent around the unit cylinder, the vertices of a grid at angles i * step and
-// heights j * height, each quad split in two. Every quad is planar (a chord x height rectangle), so
-// the triangles unroll isometrically onto the plane, where the columns lie one chord apart: that
-// unrolling has zero conformal energy, and the minimiser must be it up to a similarity, scaled to
+// it): a rectangle bent around the unit cylinder (region_cases.h), whose unrolling has zero
+// conformal energy, and the minimiser must be it up to a similarity, scaled to
 // the 3D area (|a| = 1) and not mirrored. Written independently of the solver: a sign error in the
 // area term makes the minimiser a reflection, which folds every triangle and falls back to the
 // disk map.
 TEST(RegionFlattening, ConformalMapOfABentRectangleIsItsUnrolling) {
-  constexpr int kColumns = 12, kRows = 7;
-  constexpr double kStep = 0.15, kHeight = 0.09;
-  const double chord = 2.0 * std::sin(kStep / 2.0);
-  Region region;
-  std::vector<Eigen::Vector2d> unrolled;
-  for (int j = 0; j <= kRows; ++j) {
-    for (int i = 0; i <= kColumns; ++i) {
-      region.positions.emplace_back(std::cos(i * kStep), std::sin(i * kStep), j * kHeight);
-      unrolled.emplace_back(i * chord, j * kHeight);
-    }
-  }
-  region.points.resize(region.positions.size());
-  const auto id = [](int i, int j) { return j * (kColumns + 1) + i; };
-  for (int j = 0; j < kRows; ++j) {
-    for (int i = 0; i < kColumns; ++i) {
-      region.triangles.emplace_back(id(i, j), id(i + 1, j), id(i + 1, j + 1));
-      region.triangles.emplace_back(id(i, j), id(i + 1, j + 1), id(i, j + 1));
-    }
-  }
-  // Counter-clockwise in the unrolled plane, as the triangles are.
-  for (int i = 0; i < kColumns; ++i) {
-    region.boundary.push_back(id(i, 0));
-  }
-  for (int j = 0; j < kRows; ++j) {
-    region.boundary.push_back(id(kColumns, j));
-  }
-  for (int i = kColumns; i > 0; --i) {
-    region.boundary.push_back(id(i, kRows));
-  }
-  for (int j = kRows; j > 0; --j) {
-    region.boundary.push_back(id(0, j));
-  }
+  const test::BentRectangle strip = test::bent_rectangle();
+  const Region& region = strip.region;
+  const std::vector<Eigen::Vector2d>& unrolled = strip.unrolled;
   const RegionFlattening flat = flatten_region(region, {.method = FlatteningMethod::Conformal});
   EXPECT_EQ(flat.method, FlatteningMethod::Conformal);
   EXPECT_EQ(flat.folded_triangles, 0);
@@ -296,14 +266,7 @@ TEST(RegionFlattening, ConformalMapIgnoresZeroAreaTriangles) {
   const auto mesh = make_plane({.faces = ShapeFaces::Quads, .resolution = 32});
   const LimitSurface surface(mesh);
   const SurfaceProjector projector(surface);
-  RegionSpec spec;
-  spec.kind = RegionSpec::Kind::Points;
-  for (int k = 0; k < 10; ++k) {  // tips of 36 degrees, inner radius 0.38 x 0.8
-    const double angle = kPi / 2 + kPi * k / 5;
-    const double r = (k % 2 == 0) ? 0.8 : 0.38 * 0.8;
-    spec.points.emplace_back(r * std::cos(angle), -0.05 + r * std::sin(angle), 0.0);
-  }
-  const Region region = make_region(projector, spec);
+  const Region region = make_region(projector, test::welded_star());
   int zero_area = 0;
   for (const Eigen::Vector3i& t : region.triangles) {
     const Eigen::Vector3d a =

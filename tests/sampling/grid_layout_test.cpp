@@ -14,6 +14,7 @@
 #include "elastic/shapes/procedural_shapes.h"
 #include "elastic/surface/limit_surface.h"
 #include "grid_region.h"
+#include "region_cases.h"
 
 namespace elastic {
 namespace {
@@ -229,14 +230,7 @@ TEST(GridLayout, NoFaceHasEveryCornerOnTheBoundary) {
 TEST(GridLayout, StarPolygonRegionLaysOut) {
   const LimitSurface surface(make_plane({.faces = ShapeFaces::Quads, .resolution = 32}));
   const SurfaceProjector projector(surface);
-  RegionSpec spec;
-  spec.kind = RegionSpec::Kind::Points;
-  for (int k = 0; k < 10; ++k) {
-    const double angle = std::numbers::pi / 2 + std::numbers::pi * k / 5;
-    const double r = (k % 2 == 0) ? 0.8 : 0.38 * 0.8;
-    spec.points.emplace_back(r * std::cos(angle), -0.05 + r * std::sin(angle), 0.0);
-  }
-  const Region region = make_region(projector, spec);
+  const Region region = make_region(projector, test::welded_star());
   for (const long n : {500L, 2000L}) {
     GridLayoutOptions options;
     options.particles = n;

@@ -431,42 +431,32 @@ void scale_to_area(const Region& region, std::vector<Eigen::Vector2d>& uv) {
 /// maps. Two boundary vertices (at the anchor and half the boundary length away) are pinned to
 /// remove the similarity freedom; the result is then scaled to the region's 3D area. A planar
 /// region is laid out in its own plane instead (the exact minimiser).
-RegionFlattening flatten_conformal(const Region& region) {
+///
+/// Boundary first flattening (boundary_first_flattening.h) shares the rest: the planar shortcut,
+/// the scaling to the 3D area and the fold count; where it does not apply, the result is reported
+/// as folded everywhere (the caller falls back).
+RegionFlattening flatten_conformal(const Region& region, FlatteningMethod method) {
   const std::string name = region_name(region);
   if (region.boundary.size() < 3) {
     throw NumericalError(name, "flattening: the boundary has fewer than 3 vertices");
   }
   const ConformalPins pins = conformal_pins(region);
   RegionFlattening out;
-  out.method = FlatteningMethod::Conformal;
+  out.method = method;
   if (std::optional<std::vector<Eigen::Vector2d>> flat =
           planar_coordinates(region, pins.first, pins.second)) {
     out.uv = std::move(*flat);
   } else {
-    out.uv = minimise_pinned(pinned_conformal_system(region, pins), name);
+    std::optional<std::vector<Eigen::Vector2d>> uv =
+        method == FlatteningMethod::BoundaryFirst
+            ? boundary_first_flattening(region, pins.first, pins.second)
+            : minimise_pinned(pinned_conformal_system(region, pins), name);
+    if (!uv) {
+      out.folded_triangles = region.num_triangles();
+      return out;
+    }
+    out.uv = std::move(*uv);
     scale_to_area(region, out.uv);
-  }
-  out.folded_triangles = count_folds(region, out.uv);
-  return out;
-}
-
-/// Boundary first flattening (boundary_first_flattening.h) scaled to the region's 3D area; a planar
-/// region is laid out in its own plane as by flatten_conformal, and a region the method does not
-/// apply to is reported as folded everywhere (the caller falls back).
-RegionFlattening flatten_boundary_first(const Region& region) {
-  const ConformalPins pins = conformal_pins(region);
-  RegionFlattening out;
-  out.method = FlatteningMethod::BoundaryFirst;
-  if (std::optional<std::vector<Eigen::Vector2d>> flat =
-          planar_coordinates(region, pins.first, pins.second)) {
-    out.uv = std::move(*flat);
-  } else if (std::optional<std::vector<Eigen::Vector2d>> bff =
-                 boundary_first_flattening(region, pins.first, pins.second)) {
-    out.uv = std::move(*bff);
-    scale_to_area(region, out.uv);
-  } else {
-    out.folded_triangles = region.num_triangles();
-    return out;
   }
   out.folded_triangles = count_folds(region, out.uv);
   return out;
@@ -479,12 +469,13 @@ RegionFlattening flatten_region(const Region& region, const FlatteningOptions& o
     throw InvalidInputError(region_name(region), "flattening: the region is empty");
   }
   if (options.method == FlatteningMethod::BoundaryFirst) {
-    if (RegionFlattening flat = flatten_boundary_first(region); flat.folded_triangles == 0) {
+    if (RegionFlattening flat = flatten_conformal(region, FlatteningMethod::BoundaryFirst);
+        flat.folded_triangles == 0) {
       return flat;
     }
   }
   if (options.method != FlatteningMethod::Disk) {
-    RegionFlattening conformal = flatten_conformal(region);
+    RegionFlattening conformal = flatten_conformal(region, FlatteningMethod::Conformal);
     if (conformal.folded_triangles == 0) {
       return conformal;
     }
